@@ -1,0 +1,154 @@
+//! `railforce track`.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use railforce::track::{Channel, SectionKind, Track, TrackSpec, Turn, check};
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct TrackArgs {
+    /// Track file (TOML), e.g. tracks/r400.toml.
+    file: PathBuf,
+    /// Write geometry and rail irregularities to this CSV file.
+    #[arg(long, value_name = "CSV")]
+    out: Option<PathBuf>,
+    /// Sampling step of the CSV export, m.
+    #[arg(long, default_value_t = 0.25, value_name = "M")]
+    step: f64,
+    /// Check the irregularities against the FRA PSD: print sample vs formula RMS per channel
+    /// and write the Welch PSD beside the formula to CSV.
+    #[arg(long)]
+    psd: bool,
+    /// Where `--psd` writes its CSV.
+    #[arg(long, value_name = "CSV", default_value = "psd.csv")]
+    psd_out: PathBuf,
+    /// Irregularity seed (overrides the file's `irregularity.seed`).
+    #[arg(long)]
+    seed: Option<u64>,
+}
+
+pub fn run(args: TrackArgs) -> Result<()> {
+    let spec = TrackSpec::load(&args.file)?;
+    let track = Track::new(spec, args.seed);
+    print_summary(&track);
+    if let Some(out) = &args.out {
+        track
+            .write_csv(out, args.step)
+            .with_context(|| format!("exporting {}", args.file.display()))?;
+        println!("wrote {} (every {} m)", out.display(), args.step);
+    }
+    if args.psd {
+        let irr = track.irregularities().with_context(|| {
+            format!(
+                "{}: --psd needs an [irregularity] table in the track file",
+                args.file.display()
+            )
+        })?;
+        let sp = irr.spec();
+        println!(
+            "\nIrregularity RMS, FRA class {}, band {}–{} m, seed {}, over {:.0} m:",
+            sp.class.number,
+            sp.min_wavelength,
+            sp.max_wavelength,
+            sp.seed,
+            track.length()
+        );
+        println!(
+            "  {:<12} {:>14} {:>15} {:>10}",
+            "channel", "sample RMS mm", "formula RMS mm", "deviation"
+        );
+        for c in check::rms_checks(irr, track.length()) {
+            println!(
+                "  {:<12} {:>14.3} {:>15.3} {:>+9.1}%",
+                c.channel.name(),
+                c.sample_rms * 1e3,
+                c.formula_rms * 1e3,
+                100.0 * c.deviation()
+            );
+        }
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let (w_lo, w_hi) = (two_pi / sp.max_wavelength, two_pi / sp.min_wavelength);
+        let cmp = check::psd_comparison(irr, track.length());
+        cmp.write_csv(&args.psd_out, w_lo, w_hi)?;
+        println!("  Welch / formula power per octave of the band:");
+        print!("  {:<18}", "octave (m)");
+        for ch in Channel::ALL {
+            print!(" {:>11}", ch.name());
+        }
+        println!();
+        for o in cmp.octave_ratios(w_lo, w_hi) {
+            print!("  {:<18}", format!("{:.1}–{:.1}", two_pi / o.hi, two_pi / o.lo));
+            for r in o.ratio {
+                print!(" {r:>11.3}");
+            }
+            println!();
+        }
+        println!(
+            "wrote {} ({} Welch segments)",
+            args.psd_out.display(),
+            cmp.segments
+        );
+    }
+    Ok(())
+}
+
+fn print_summary(track: &Track) {
+    let spec = track.spec();
+    println!(
+        "{} — {:.1} m, gauge {} m, rail spacing {} m",
+        spec.name,
+        track.length(),
+        spec.gauge,
+        spec.rail_spacing
+    );
+    if !spec.description.is_empty() {
+        println!("  {}", spec.description);
+    }
+    for (i, sec) in spec.sections.iter().enumerate() {
+        let what = match sec.kind {
+            SectionKind::Tangent => "tangent".to_string(),
+            SectionKind::Transition => "transition (clothoid, linear cant ramp)".to_string(),
+            SectionKind::Curve { radius, cant, turn } => {
+                let v_eq = sec.balance_speed(spec.rail_spacing).unwrap_or(0.0);
+                format!(
+                    "curve {} R {radius} m, cant {:.0} mm, balance speed {:.1} km/h",
+                    match turn {
+                        Turn::Left => "left",
+                        Turn::Right => "right",
+                    },
+                    cant * 1e3,
+                    v_eq * 3.6
+                )
+            }
+        };
+        println!(
+            "  [{i}] {:>8.1}–{:<8.1} m  {what}",
+            sec.start,
+            sec.end()
+        );
+    }
+    let grades = spec.profile.grades();
+    if grades.len() > 1 || grades[0].gradient != 0.0 {
+        for g in grades {
+            let rv = if g.vertical_curve_radius.is_finite() {
+                format!(", vertical curve R {} m", g.vertical_curve_radius)
+            } else {
+                String::new()
+            };
+            println!(
+                "  grade from {:.1} m: {:+.1} ‰{rv}",
+                g.at,
+                g.gradient * 1e3
+            );
+        }
+    } else {
+        println!("  level");
+    }
+    match &spec.irregularity {
+        Some(irr) => println!(
+            "  irregularities: FRA class {}, wavelengths {}–{} m, seed {}",
+            irr.class.number, irr.min_wavelength, irr.max_wavelength, irr.seed
+        ),
+        None => println!("  no irregularities (smooth track)"),
+    }
+}

@@ -1,0 +1,20 @@
+//! # railforce
+//!
+//! Railway vehicle dynamics and wheel–rail force identification: a C80 heavy-haul wagon on
+//! tracks with FRA irregularities, virtual sensors, data sets, and force identification.
+//!
+//! Data flows one way: [`track`] → simulation → sensors → data sets → features → models.
+//! Every stage is a module with a small public surface.
+
+#![warn(missing_docs)]
+
+pub mod dsp;
+pub mod error;
+pub mod io;
+pub mod plan;
+pub mod track;
+
+pub use error::{Error, Result};
+
+/// Standard gravity, m/s².
+pub const GRAVITY: f64 = 9.81;

@@ -1,0 +1,263 @@
+//! Track irregularities from the US FRA track-class PSDs (spec §3.2).
+//!
+//! One-sided PSDs in cm²/(rad/m), Ω in rad/m, k = 0.25:
+//! vertical profile and alignment `k·A·Ω_c²/(Ω²(Ω² + Ω_c²))`, cross-level and gauge
+//! `4·k·A_v·Ω_c²/((Ω² + Ω_c²)(Ω² + Ω_s²))`. Samples are a sum of cosines with uniform random
+//! phases, `z(x) = Σ √(2·S(Ω_k)·ΔΩ)·cos(Ω_k·x + φ_k)`, evaluated with one inverse FFT on a grid
+//! whose period is at least twice the track length (so nothing repeats along the track), then
+//! read with cubic interpolation.
+
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::SeedableRng;
+use rand_distr::{Distribution, Uniform};
+use rustfft::FftPlanner;
+use rustfft::num_complex::Complex64;
+
+/// FRA PSD constant k (all classes).
+const FRA_K: f64 = 0.25;
+/// 1 cm² = 1e-4 m².
+const CM2: f64 = 1e-4;
+
+/// A US FRA track class (1 = worst, 6 = best) with its PSD parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FraClass {
+    /// Class number 1–6.
+    pub number: u8,
+    /// Vertical roughness A_v, cm²·rad/m.
+    pub a_v: f64,
+    /// Alignment roughness A_a, cm²·rad/m.
+    pub a_a: f64,
+    /// Break frequency Ω_s, rad/m.
+    pub omega_s: f64,
+    /// Break frequency Ω_c, rad/m.
+    pub omega_c: f64,
+}
+
+/// (A_v, A_a, Ω_s, Ω_c) for classes 1–6 (FRA, as tabulated in spec §3.2).
+const FRA_TABLE: [(f64, f64, f64, f64); 6] = [
+    (1.2107, 3.3634, 0.6046, 0.8245),
+    (1.0181, 1.2107, 0.9308, 0.8245),
+    (0.6816, 0.4128, 0.8520, 0.8245),
+    (0.5376, 0.3027, 1.1312, 0.8245),
+    (0.2095, 0.0762, 0.8209, 0.8245),
+    (0.0339, 0.0339, 0.4380, 0.8245),
+];
+
+impl FraClass {
+    /// The class with this number, or `None` outside 1–6.
+    pub fn new(number: i64) -> Option<Self> {
+        let idx = usize::try_from(number).ok()?.checked_sub(1)?;
+        let (a_v, a_a, omega_s, omega_c) = *FRA_TABLE.get(idx)?;
+        Some(FraClass {
+            number: number as u8,
+            a_v,
+            a_a,
+            omega_s,
+            omega_c,
+        })
+    }
+
+    /// One-sided PSD of a channel at Ω (rad/m), in m²/(rad/m).
+    pub fn psd(&self, channel: Channel, omega: f64) -> f64 {
+        let (w2, c2, s2) = (
+            omega * omega,
+            self.omega_c * self.omega_c,
+            self.omega_s * self.omega_s,
+        );
+        let cm2 = match channel {
+            Channel::Vertical => FRA_K * self.a_v * c2 / (w2 * (w2 + c2)),
+            Channel::Alignment => FRA_K * self.a_a * c2 / (w2 * (w2 + c2)),
+            Channel::CrossLevel | Channel::Gauge => {
+                4.0 * FRA_K * self.a_v * c2 / ((w2 + c2) * (w2 + s2))
+            }
+        };
+        cm2 * CM2
+    }
+
+    /// RMS (m) that the PSD gives over the wavelength band `[λ_min, λ_max]`:
+    /// `σ² = ∫ S dΩ` from `2π/λ_max` to `2π/λ_min` (Simpson's rule in ln Ω).
+    pub fn band_rms(&self, channel: Channel, min_wavelength: f64, max_wavelength: f64) -> f64 {
+        let (lo, hi) = (
+            (2.0 * std::f64::consts::PI / max_wavelength).ln(),
+            (2.0 * std::f64::consts::PI / min_wavelength).ln(),
+        );
+        let n = 4000; // even
+        let h = (hi - lo) / n as f64;
+        let f = |u: f64| {
+            let w = u.exp();
+            self.psd(channel, w) * w // dΩ = Ω du
+        };
+        let mut sum = f(lo) + f(hi);
+        for i in 1..n {
+            sum += f(lo + i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        (sum * h / 3.0).sqrt()
+    }
+}
+
+/// The four irregularity channels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Channel {
+    /// Vertical profile (mean of the two rails' heights).
+    Vertical,
+    /// Alignment (mean lateral position of the two rails).
+    Alignment,
+    /// Cross-level, as a height difference left − right.
+    CrossLevel,
+    /// Gauge deviation (wider positive).
+    Gauge,
+}
+
+impl Channel {
+    /// All channels in synthesis order (the order random phases are drawn in).
+    pub const ALL: [Channel; 4] = [
+        Channel::Vertical,
+        Channel::Alignment,
+        Channel::CrossLevel,
+        Channel::Gauge,
+    ];
+
+    /// Name used in files and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Channel::Vertical => "vertical",
+            Channel::Alignment => "alignment",
+            Channel::CrossLevel => "cross_level",
+            Channel::Gauge => "gauge",
+        }
+    }
+}
+
+/// Irregularity settings of a track file.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IrregularitySpec {
+    /// FRA class.
+    pub class: FraClass,
+    /// Shortest wavelength synthesised, m.
+    pub min_wavelength: f64,
+    /// Longest wavelength synthesised, m.
+    pub max_wavelength: f64,
+    /// Random seed of the phases.
+    pub seed: u64,
+}
+
+/// Offsets of both rails at one position, m, with their derivatives along the track (1/1).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RailIrregularity {
+    /// Lateral offset of the left rail (+ to the left).
+    pub left_y: f64,
+    /// Vertical offset of the left rail (+ up).
+    pub left_z: f64,
+    /// Lateral offset of the right rail.
+    pub right_y: f64,
+    /// Vertical offset of the right rail.
+    pub right_z: f64,
+    /// d(left_y)/ds.
+    pub left_y_ds: f64,
+    /// d(left_z)/ds.
+    pub left_z_ds: f64,
+    /// d(right_y)/ds.
+    pub right_y_ds: f64,
+    /// d(right_z)/ds.
+    pub right_z_ds: f64,
+}
+
+/// Synthesised irregularity samples along a track.
+#[derive(Debug, Clone)]
+pub struct Irregularities {
+    spec: IrregularitySpec,
+    dx: f64,
+    /// Position of the first sample, m (two steps before 0 so interpolation needs no clamping).
+    origin: f64,
+    /// Samples per channel (order of [`Channel::ALL`]) at `s = origin + i·dx`.
+    samples: [Vec<f64>; 4],
+}
+
+impl Irregularities {
+    /// Synthesises the four channels over `[0, length]`.
+    pub fn synthesize(spec: IrregularitySpec, length: f64) -> Self {
+        use std::f64::consts::PI;
+        // 16 points per shortest wavelength keeps cubic interpolation error below 0.1 %.
+        let dx = spec.min_wavelength / 16.0;
+        let n_pts = (length / dx).ceil() as usize + 6;
+        let n_fft = (2 * n_pts).next_power_of_two();
+        let d_omega = 2.0 * PI / (n_fft as f64 * dx);
+        let (w_lo, w_hi) = (2.0 * PI / spec.max_wavelength, 2.0 * PI / spec.min_wavelength);
+        let k_lo = (w_lo / d_omega).ceil().max(1.0) as usize;
+        let k_hi = ((w_hi / d_omega).floor() as usize).min(n_fft / 2 - 1);
+        let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
+        let phase = Uniform::new(0.0, 2.0 * PI).expect("valid range");
+        let fft = FftPlanner::<f64>::new().plan_fft_inverse(n_fft);
+        let samples = Channel::ALL.map(|ch| {
+            let mut buf = vec![Complex64::new(0.0, 0.0); n_fft];
+            for (k, b) in buf.iter_mut().enumerate().take(k_hi + 1).skip(k_lo) {
+                let amp = (2.0 * spec.class.psd(ch, k as f64 * d_omega) * d_omega).sqrt();
+                *b = Complex64::from_polar(amp, phase.sample(&mut rng));
+            }
+            fft.process(&mut buf);
+            buf.truncate(n_pts);
+            buf.into_iter().map(|c| c.re).collect()
+        });
+        Irregularities {
+            spec,
+            dx,
+            origin: -2.0 * dx,
+            samples,
+        }
+    }
+
+    /// The settings they were made with.
+    pub fn spec(&self) -> &IrregularitySpec {
+        &self.spec
+    }
+
+    /// Grid spacing of the stored samples, m.
+    pub fn grid_step(&self) -> f64 {
+        self.dx
+    }
+
+    /// Position of the first raw sample, m (negative: the grid starts before the track).
+    pub fn grid_origin(&self) -> f64 {
+        self.origin
+    }
+
+    /// Raw samples of a channel on the grid `s = grid_origin() + i·grid_step()`, m.
+    pub fn channel_samples(&self, ch: Channel) -> &[f64] {
+        &self.samples[ch as usize]
+    }
+
+    /// One channel and its derivative at `s` (Catmull–Rom cubic interpolation).
+    pub fn channel_at(&self, ch: Channel, s: f64) -> (f64, f64) {
+        let v = &self.samples[ch as usize];
+        let u = ((s - self.origin) / self.dx).clamp(1.0, (v.len() - 3) as f64);
+        let i = (u.floor() as usize).min(v.len() - 3);
+        let t = u - i as f64;
+        let (p0, p1, p2, p3) = (v[i - 1], v[i], v[i + 1], v[i + 2]);
+        let a = 2.0 * p1;
+        let b = p2 - p0;
+        let c = 2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3;
+        let d = -p0 + 3.0 * p1 - 3.0 * p2 + p3;
+        let val = 0.5 * (a + t * (b + t * (c + t * d)));
+        let der = 0.5 * (b + t * (2.0 * c + 3.0 * t * d)) / self.dx;
+        (val, der)
+    }
+
+    /// Offsets of both rails at `s`: `z_L = z_v + z_c/2`, `z_R = z_v − z_c/2`,
+    /// `y_L = y_a + y_g/2`, `y_R = y_a − y_g/2`.
+    pub fn rails_at(&self, s: f64) -> RailIrregularity {
+        let (zv, zv_d) = self.channel_at(Channel::Vertical, s);
+        let (ya, ya_d) = self.channel_at(Channel::Alignment, s);
+        let (zc, zc_d) = self.channel_at(Channel::CrossLevel, s);
+        let (yg, yg_d) = self.channel_at(Channel::Gauge, s);
+        RailIrregularity {
+            left_y: ya + 0.5 * yg,
+            left_z: zv + 0.5 * zc,
+            right_y: ya - 0.5 * yg,
+            right_z: zv - 0.5 * zc,
+            left_y_ds: ya_d + 0.5 * yg_d,
+            left_z_ds: zv_d + 0.5 * zc_d,
+            right_y_ds: ya_d - 0.5 * yg_d,
+            right_z_ds: zv_d - 0.5 * zc_d,
+        }
+    }
+}
