@@ -82,7 +82,11 @@ impl Plan {
             if v.is_finite() && v > 0.0 {
                 Ok(v)
             } else {
-                Err(Error::config(path, field, format!("must be positive, got {v}")))
+                Err(Error::config(
+                    path,
+                    field,
+                    format!("must be positive, got {v}"),
+                ))
             }
         };
         positive("duration_s".into(), raw.duration_s)?;

@@ -77,7 +77,10 @@ pub fn run(args: TrackArgs) -> Result<()> {
         }
         println!();
         for o in cmp.octave_ratios(w_lo, w_hi) {
-            print!("  {:<18}", format!("{:.1}–{:.1}", two_pi / o.hi, two_pi / o.lo));
+            print!(
+                "  {:<18}",
+                format!("{:.1}–{:.1}", two_pi / o.hi, two_pi / o.lo)
+            );
             for r in o.ratio {
                 print!(" {r:>11.3}");
             }
@@ -121,11 +124,7 @@ fn print_summary(track: &Track) {
                 )
             }
         };
-        println!(
-            "  [{i}] {:>8.1}–{:<8.1} m  {what}",
-            sec.start,
-            sec.end()
-        );
+        println!("  [{i}] {:>8.1}–{:<8.1} m  {what}", sec.start, sec.end());
     }
     let grades = spec.profile.grades();
     if grades.len() > 1 || grades[0].gradient != 0.0 {
@@ -135,11 +134,7 @@ fn print_summary(track: &Track) {
             } else {
                 String::new()
             };
-            println!(
-                "  grade from {:.1} m: {:+.1} ‰{rv}",
-                g.at,
-                g.gradient * 1e3
-            );
+            println!("  grade from {:.1} m: {:+.1} ‰{rv}", g.at, g.gradient * 1e3);
         }
     } else {
         println!("  level");

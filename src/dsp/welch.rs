@@ -21,9 +21,7 @@ pub fn welch_psd(x: &[f64], dx: f64, nperseg: usize) -> WelchPsd {
     let nperseg = nperseg.min(x.len()).max(2);
     let step = (nperseg / 2).max(1);
     let window: Vec<f64> = (0..nperseg)
-        .map(|i| {
-            0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / nperseg as f64).cos()
-        })
+        .map(|i| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / nperseg as f64).cos())
         .collect();
     let wss: f64 = window.iter().map(|w| w * w).sum();
     let fft = FftPlanner::<f64>::new().plan_fft_forward(nperseg);

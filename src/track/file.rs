@@ -145,7 +145,11 @@ impl TrackSpec {
             if let Some(s0) = sf.start_m {
                 let gap = s0 - start;
                 if gap.abs() > 1e-6 {
-                    let what = if gap > 0.0 { "leaves a gap" } else { "overlaps" };
+                    let what = if gap > 0.0 {
+                        "leaves a gap"
+                    } else {
+                        "overlaps"
+                    };
                     return Err(err(
                         f("start_m"),
                         format!(
@@ -158,7 +162,10 @@ impl TrackSpec {
                 if present {
                     Err(err(
                         f(name),
-                        format!("only curve sections take {name} (this one is '{}')", sf.kind),
+                        format!(
+                            "only curve sections take {name} (this one is '{}')",
+                            sf.kind
+                        ),
                     ))
                 } else {
                     Ok(())
@@ -228,7 +235,13 @@ impl TrackSpec {
                 }
             };
             if matches!(kind, SectionKind::Transition)
-                && matches!(sections.last(), Some(Section { kind: SectionKind::Transition, .. }))
+                && matches!(
+                    sections.last(),
+                    Some(Section {
+                        kind: SectionKind::Transition,
+                        ..
+                    })
+                )
             {
                 return Err(err(
                     f("kind"),
@@ -388,10 +401,7 @@ fn parse_profile(p: &ProfileFile, path: &Path, length: f64) -> Result<VerticalPr
             ));
         }
         if i > 0 && radius.is_infinite() && g.vertical_curve_radius_m.is_some() {
-            return Err(err(
-                f("vertical_curve_radius_m"),
-                "must be finite".into(),
-            ));
+            return Err(err(f("vertical_curve_radius_m"), "must be finite".into()));
         }
         grades.push(Grade {
             at: g.at_m,
@@ -410,13 +420,13 @@ fn parse_profile(p: &ProfileFile, path: &Path, length: f64) -> Result<VerticalPr
     // Vertical curves must not overlap each other nor run off the track.
     let zones = profile.rounding_zones();
     for (i, zone) in zones.iter().enumerate() {
-        if let Some((a, b)) = *zone {
-            if a < 0.0 || b > length {
-                return Err(err(
-                    format!("profile.grade[{i}].vertical_curve_radius_m"),
-                    format!("the vertical curve spans {a:.1}–{b:.1} m, off the track (0–{length} m)"),
-                ));
-            }
+        if let Some((a, b)) = *zone
+            && (a < 0.0 || b > length)
+        {
+            return Err(err(
+                format!("profile.grade[{i}].vertical_curve_radius_m"),
+                format!("the vertical curve spans {a:.1}–{b:.1} m, off the track (0–{length} m)"),
+            ));
         }
     }
     let spans: Vec<(usize, f64, f64)> = zones

@@ -182,7 +182,10 @@ impl Irregularities {
         let n_pts = (length / dx).ceil() as usize + 6;
         let n_fft = (2 * n_pts).next_power_of_two();
         let d_omega = 2.0 * PI / (n_fft as f64 * dx);
-        let (w_lo, w_hi) = (2.0 * PI / spec.max_wavelength, 2.0 * PI / spec.min_wavelength);
+        let (w_lo, w_hi) = (
+            2.0 * PI / spec.max_wavelength,
+            2.0 * PI / spec.min_wavelength,
+        );
         let k_lo = (w_lo / d_omega).ceil().max(1.0) as usize;
         let k_hi = ((w_hi / d_omega).floor() as usize).min(n_fft / 2 - 1);
         let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);

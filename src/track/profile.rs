@@ -73,7 +73,7 @@ impl VerticalProfile {
             .enumerate()
             .map(|(i, g)| {
                 let t = self.half_length(i);
-                (t > 0.0).then(|| (g.at - t, g.at + t))
+                (t > 0.0).then_some((g.at - t, g.at + t))
             })
             .collect()
     }

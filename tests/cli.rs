@@ -1,0 +1,92 @@
+//! The command line as a user runs it.
+
+use std::process::Command;
+
+fn railforce(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_railforce"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("railforce-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn help_explains_each_subcommand() {
+    let (ok, out, _) = railforce(&["--help"]);
+    assert!(ok);
+    assert!(out.contains("track"), "{out}");
+    let (ok, out, _) = railforce(&["track", "--help"]);
+    assert!(
+        ok && out.contains("--psd") && out.contains("--step"),
+        "{out}"
+    );
+}
+
+#[test]
+fn track_summary_export_and_psd() {
+    let csv = tmp("r400.csv");
+    let psd = tmp("r400_psd.csv");
+    let (ok, out, err) = railforce(&[
+        "track",
+        "tracks/curve_r400.toml",
+        "--out",
+        csv.to_str().unwrap(),
+        "--step",
+        "1",
+        "--psd",
+        "--psd-out",
+        psd.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("balance speed 79.8 km/h"), "{out}");
+    assert!(out.contains("formula RMS"), "{out}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header[0], "s_m");
+    assert!(header.contains(&"left_z_m") && header.contains(&"cant_angle_rad"));
+    assert_eq!(lines.count(), 2201, "0..=2200 m every 1 m");
+    let psd_text = std::fs::read_to_string(&psd).unwrap();
+    assert!(psd_text.starts_with("omega_rad_per_m,wavelength_m,vertical_welch"));
+    // Same seed, same bytes.
+    let csv2 = tmp("r400b.csv");
+    let (ok, _, _) = railforce(&[
+        "track",
+        "tracks/curve_r400.toml",
+        "--out",
+        csv2.to_str().unwrap(),
+        "--step",
+        "1",
+    ]);
+    assert!(ok);
+    assert_eq!(std::fs::read(&csv).unwrap(), std::fs::read(&csv2).unwrap());
+}
+
+#[test]
+fn bad_track_file_fails_with_file_and_field() {
+    let bad = tmp("bad.toml");
+    std::fs::write(
+        &bad,
+        "[[section]]\nkind = \"curve\"\nlength_m = 100\nradius_m = 400\ncant_mm = 300\ndirection = \"right\"\n",
+    )
+    .unwrap();
+    let (ok, _, err) = railforce(&["track", bad.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(
+        err.contains("bad.toml") && err.contains("section[0].cant_mm"),
+        "{err}"
+    );
+    let (ok, _, err) = railforce(&["track", "no/such/file.toml"]);
+    assert!(!ok && err.contains("no/such/file.toml"), "{err}");
+}
