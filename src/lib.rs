@@ -8,6 +8,7 @@
 
 #![warn(missing_docs)]
 
+pub mod contact;
 pub mod dsp;
 pub mod error;
 pub mod io;
