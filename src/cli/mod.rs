@@ -1,7 +1,9 @@
 //! Command-line parsing and dispatch. Each subcommand lives in its own file and only turns
 //! arguments into library calls and library results into text.
 
+mod contact;
 mod track;
+mod validate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -26,6 +28,16 @@ enum Command {
     /// irregular offsets every `--step` metres as CSV; `--psd` compares the synthesised
     /// irregularities with the FRA PSD formula (RMS table, Welch PSD to CSV).
     Track(track::TrackArgs),
+    /// Contact of both wheels of a wheelset in a given state: contact points, angles,
+    /// ellipses, creepages and forces.
+    ///
+    /// Solves the rigid contact geometry for the lateral shift and yaw, shares each wheel's
+    /// load between its contact points (two-point contact), and evaluates Hertz and the creep
+    /// law. Forces are those of the rail on the wheel: Fx, Fy in the contact plane; Y (+ left)
+    /// and Q (+ up) in the track frame.
+    Contact(contact::ContactArgs),
+    /// Check railforce against reference solutions (`validate contact`).
+    Validate(validate::ValidateArgs),
 }
 
 /// Parses the command line, runs the subcommand and turns errors into a message and exit 1.
@@ -33,6 +45,8 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Track(args) => track::run(args),
+        Command::Contact(args) => contact::run(args),
+        Command::Validate(args) => validate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

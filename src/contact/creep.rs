@@ -185,9 +185,21 @@ mod tests {
     fn all_laws_agree_with_linear_theory_at_small_creepage() {
         let c = contact();
         for s in [
-            Creepage { x: 1e-6, y: 0.0, spin: 0.0 },
-            Creepage { x: 0.0, y: -1e-6, spin: 0.0 },
-            Creepage { x: 5e-7, y: 5e-7, spin: 0.0 },
+            Creepage {
+                x: 1e-6,
+                y: 0.0,
+                spin: 0.0,
+            },
+            Creepage {
+                x: 0.0,
+                y: -1e-6,
+                spin: 0.0,
+            },
+            Creepage {
+                x: 5e-7,
+                y: 5e-7,
+                spin: 0.0,
+            },
         ] {
             let lin = CreepLaw::Linear.force(&c, s);
             let scale = lin.x.abs().max(lin.y.abs());
@@ -204,7 +216,11 @@ mod tests {
             }
         }
         // Spin alone: Polach and FASTSIM give the linear C23 force at tiny spin.
-        let s = Creepage { x: 0.0, y: 0.0, spin: 1e-5 };
+        let s = Creepage {
+            x: 0.0,
+            y: 0.0,
+            spin: 1e-5,
+        };
         let lin = CreepLaw::Linear.force(&c, s);
         let fs = CreepLaw::Fastsim { n: 200 }.force(&c, s);
         assert!((fs.y / lin.y - 1.0).abs() < 0.02, "{fs:?} {lin:?}");
@@ -214,10 +230,27 @@ mod tests {
     fn saturated_force_is_mu_n_and_opposes_slip() {
         let c = contact();
         for law in [CreepLaw::Polach, CreepLaw::Fastsim { n: 60 }] {
-            let f = law.force(&c, Creepage { x: 0.1, y: 0.0, spin: 0.0 });
+            let f = law.force(
+                &c,
+                Creepage {
+                    x: 0.1,
+                    y: 0.0,
+                    spin: 0.0,
+                },
+            );
             assert!(f.x < 0.0);
-            assert!((f.x.abs() / (c.mu * c.normal) - 1.0).abs() < 0.02, "{law:?} {f:?}");
-            let f = law.force(&c, Creepage { x: 0.05, y: -0.05, spin: 0.0 });
+            assert!(
+                (f.x.abs() / (c.mu * c.normal) - 1.0).abs() < 0.02,
+                "{law:?} {f:?}"
+            );
+            let f = law.force(
+                &c,
+                Creepage {
+                    x: 0.05,
+                    y: -0.05,
+                    spin: 0.0,
+                },
+            );
             let mag = (f.x * f.x + f.y * f.y).sqrt();
             assert!(
                 mag <= c.mu * c.normal * 1.002 && mag > 0.95 * c.mu * c.normal,

@@ -26,12 +26,7 @@ pub struct Profile {
 
 impl Profile {
     /// Samples `f(y) -> (z, dz/dy, d²z/dy²)` on `[y_min, y_max]`.
-    pub fn from_fn(
-        name: &str,
-        y_min: f64,
-        y_max: f64,
-        f: impl Fn(f64) -> (f64, f64, f64),
-    ) -> Self {
+    pub fn from_fn(name: &str, y_min: f64, y_max: f64, f: impl Fn(f64) -> (f64, f64, f64)) -> Self {
         let n = ((y_max - y_min) / GRID_STEP).floor() as usize + 1;
         let (mut z, mut dz, mut d2z) = (
             Vec::with_capacity(n),
@@ -153,7 +148,10 @@ impl Profile {
         for i in (0..start.min(self.z.len() - 1)).rev() {
             if (self.z[i] - z) * (self.z[i + 1] - z) <= 0.0 {
                 // Bisection on the interpolant.
-                let (mut a, mut b) = (self.y0 + i as f64 * self.h, self.y0 + (i + 1) as f64 * self.h);
+                let (mut a, mut b) = (
+                    self.y0 + i as f64 * self.h,
+                    self.y0 + (i + 1) as f64 * self.h,
+                );
                 for _ in 0..50 {
                     let m = 0.5 * (a + b);
                     if (self.eval(a).0 - z) * (self.eval(m).0 - z) <= 0.0 {
@@ -189,7 +187,7 @@ impl CubicSpline {
             return Err(format!("a profile needs at least 4 points, got {n}"));
         }
         for (i, w) in pts.windows(2).enumerate() {
-            if !(w[1].0 > w[0].0) {
+            if w[1].0 <= w[0].0 || w[1].0.is_nan() {
                 return Err(format!(
                     "profile y is not strictly monotonic at point {} (y {} after {})",
                     i + 2,
@@ -358,6 +356,23 @@ pub fn rail_60kg() -> Profile {
     })
 }
 
+/// A wheel profile by name (`s1002`) or from a file (see [`load`]).
+pub fn wheel_by_name_or_file(spec: &str) -> Result<Profile> {
+    match spec.to_ascii_lowercase().as_str() {
+        "s1002" => Ok(s1002()),
+        _ => load(Path::new(spec), LoadOptions::default()),
+    }
+}
+
+/// A rail profile by name (`60kg`, alias `chn60`, `60e1`, `uic60`: upright, to be inclined by
+/// the caller) or from a file (see [`load`]).
+pub fn rail_by_name_or_file(spec: &str) -> Result<Profile> {
+    match spec.to_ascii_lowercase().as_str() {
+        "60kg" | "chn60" | "60e1" | "uic60" => Ok(rail_60kg()),
+        _ => load(Path::new(spec), LoadOptions::default()),
+    }
+}
+
 /// Options for reading a profile file.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct LoadOptions {
@@ -512,7 +527,15 @@ mod tests {
     fn s1002_is_continuous_and_has_a_28mm_flange() {
         let p = s1002();
         // Section joints: value continuity to 0.01 mm.
-        for yj in [32.15796, -26.0, -35.0, -38.426669071, -39.764473993, -49.662510381, -62.764705882] {
+        for yj in [
+            32.15796,
+            -26.0,
+            -35.0,
+            -38.426669071,
+            -39.764473993,
+            -49.662510381,
+            -62.764705882,
+        ] {
             let a = s1002_mm(yj - 1e-7).0;
             let b = s1002_mm(yj + 1e-7).0;
             assert!((a - b).abs() < 0.01, "jump {a} {b} at {yj}");
@@ -529,7 +552,11 @@ mod tests {
     fn rail_head_is_72_mm_wide_and_smooth() {
         let r = rail_60kg();
         let g = r.crossing_below(0.0, 0.014).unwrap();
-        assert!((2.0 * g.abs() - 0.072).abs() < 1e-3, "width at 14 mm {}", 2.0 * g);
+        assert!(
+            (2.0 * g.abs() - 0.072).abs() < 1e-3,
+            "width at 14 mm {}",
+            2.0 * g
+        );
         // Slope continuity at the arc joints.
         for yj in [10.228e-3, 26.027e-3] {
             let (a, b) = (r.eval(yj - 1e-6).1, r.eval(yj + 1e-6).1);

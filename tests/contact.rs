@@ -1,0 +1,237 @@
+//! Contact model against closed forms and the CONTACT reference data in ../shared/reference.
+
+use railforce::contact::profile::{self, LoadOptions, Profile};
+use railforce::contact::validate::{self, ProfileSource};
+use railforce::contact::{Side, WheelsetGeometry};
+use std::path::{Path, PathBuf};
+
+/// The reference folder, or `None` (skip) when absent outside CI; CI without it is an error.
+fn reference_dir() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/reference");
+    if dir.join("mbench_a22_reference.json").exists() {
+        return Some(dir);
+    }
+    if std::env::var_os("CI").is_some() {
+        panic!(
+            "reference data missing at {} while CI is set: the contact validation cannot run",
+            dir.display()
+        );
+    }
+    eprintln!("skipping: no reference data at {}", dir.display());
+    None
+}
+
+#[test]
+fn manchester_a22_with_benchmark_profiles_within_tolerance() {
+    let Some(dir) = reference_dir() else { return };
+    let rows = validate::manchester_a22(&dir, ProfileSource::Benchmark).unwrap();
+    assert_eq!(rows.len(), 42, "21 cases × 2 wheels");
+    for r in &rows {
+        assert!(
+            r.passes(),
+            "case {} {:?}: position {:.3} vs {:.3} mm, angle {:.3} vs {:.3}°",
+            r.case,
+            r.side,
+            r.position.0 * 1e3,
+            r.position.1 * 1e3,
+            r.angle.0.to_degrees(),
+            r.angle.1.to_degrees()
+        );
+        // Roll within 5 % of the reference or 0.02 mrad.
+        assert!(
+            (r.roll.0 - r.roll.1).abs() < 2e-5 + 0.05 * r.roll.1.abs(),
+            "{r:?}"
+        );
+    }
+    // The jump to flange contact on the right wheel at 6.5 mm: contact angle beyond 60°.
+    let flange = rows
+        .iter()
+        .find(|r| r.case == 14 && r.side == Side::Right)
+        .unwrap();
+    assert!(flange.angle.0.abs() > 60f64.to_radians());
+    let before = rows
+        .iter()
+        .find(|r| r.case == 13 && r.side == Side::Right)
+        .unwrap();
+    assert!(before.angle.0.abs() < 30f64.to_radians());
+}
+
+#[test]
+fn analytic_profiles_match_the_benchmark_files() {
+    let Some(dir) = reference_dir() else { return };
+    // Wheel: the analytic S1002 against the benchmark's sampled S1002.
+    let bench = profile::load(
+        &dir.join("profiles/MBench_S1002_v3.prw"),
+        LoadOptions::default(),
+    )
+    .unwrap();
+    let ours = profile::s1002();
+    let mut worst: f64 = 0.0;
+    for i in 0..=1150 {
+        let y = -55e-3 + i as f64 * 1e-4;
+        worst = worst.max((bench.eval(y).0 - ours.eval(y).0).abs());
+    }
+    assert!(worst < 0.05e-3, "S1002 deviates {:.4} mm", worst * 1e3);
+    // Rail: both mounted the same way (top at 0, gauge point at 0) over the running surface.
+    let geo = |rail: Profile, incl: f64| {
+        WheelsetGeometry::new(profile::s1002(), rail, incl, 1.435, 1.36, 0.07, 0.46).unwrap()
+    };
+    let b = geo(
+        profile::load(
+            &dir.join("profiles/MBench_UIC60_v3.prr"),
+            LoadOptions::default(),
+        )
+        .unwrap(),
+        0.0,
+    );
+    let o = geo(profile::rail_60kg(), (1.0f64 / 40.0).atan());
+    let mut worst: f64 = 0.0;
+    for i in 0..=600 {
+        let y = 2e-3 + i as f64 * 1e-4; // from the gauge corner to 62 mm field-ward
+        worst = worst.max((b.rail().eval(y).0 - o.rail().eval(y).0).abs());
+    }
+    assert!(worst < 0.1e-3, "rail deviates {:.4} mm", worst * 1e3);
+}
+
+#[test]
+fn creep_curve_polach_and_fastsim_against_contact() {
+    let Some(dir) = reference_dir() else { return };
+    let rows = validate::tractcurv(&dir).unwrap();
+    assert_eq!(rows.len(), 60);
+    for r in &rows {
+        assert!(
+            r.passes(),
+            "{} at ξ {}: {:.4} vs {:.4}",
+            r.method,
+            r.creepage,
+            r.force.0,
+            r.force.1
+        );
+    }
+    // At small creepage both follow the linear theory (within 3 %).
+    for r in rows.iter().filter(|r| r.creepage <= 1e-5) {
+        assert!((r.force.0 / r.force.1 - 1.0).abs() < 0.03, "{r:?}");
+    }
+}
+
+/// A conical wheel (conicity λ) on rails with a circular crown of radius R. Under a shift y
+/// the wheelset rolls by φ = Δr/(2b) (b half the contact spacing, both wheels touching); the
+/// roll moves the wheels' lowest points sideways by r0·φ and, by tilting the cones, the contact
+/// along each crown by R·φ. Hence Δr = 2λ(y + (r0 + R)·φ) = 2λy·b/(b − λ(r0 + R)): an
+/// effective conicity λ·b/(b − λ(r0 + R)), which is also the equivalent conicity.
+#[test]
+fn conical_wheel_on_round_rail_matches_closed_form() {
+    let lambda = 0.05;
+    let wheel = Profile::from_fn("cone", -60e-3, 60e-3, |y| (-lambda * y, -lambda, 0.0));
+    let r = 0.03;
+    let rail = Profile::from_fn("round", -29e-3, 29e-3, |y| {
+        let s = (r * r - y * y).sqrt();
+        (r - s, y / s, r * r / (s * s * s))
+    });
+    let geo = WheelsetGeometry::new(wheel, rail, 0.0, 1.435, 1.36, 0.07, 0.42).unwrap();
+    let centred = geo.solve(0.0, 0.0);
+    assert!(centred.roll.abs() < 1e-9);
+    for k in 0..2 {
+        assert!((centred.wheels[k].angle - lambda.atan()).abs() < 1e-4);
+        // Flat-tread wheel: no lateral curvature; the rail's is 1/R at the contact.
+        assert!(centred.wheels[k].wheel_curvature.abs() < 1e-9);
+        assert!((centred.wheels[k].rail_curvature * r - 1.0).abs() < 0.01);
+    }
+    let b = 0.5 * (centred.wheels[0].point[1] - centred.wheels[1].point[1]);
+    let r0 = centred.wheels[0].rolling_radius;
+    let effective = lambda * b / (b - lambda * (r0 + r));
+    for y in [-4e-3, -1e-3, 2e-3, 5e-3] {
+        let s = geo.solve(y, 0.0);
+        let dr = s.wheels[0].rolling_radius - s.wheels[1].rolling_radius;
+        assert!(
+            (dr / (2.0 * effective * y) - 1.0).abs() < 0.001,
+            "y {y}: Δr {dr} vs {}",
+            2.0 * effective * y
+        );
+        assert!(
+            (s.roll / (dr / (2.0 * b)) - 1.0).abs() < 0.01,
+            "roll {}",
+            s.roll
+        );
+        // The wheel with the larger radius is on the side the wheelset moved to.
+        assert_eq!(dr > 0.0, y > 0.0);
+    }
+    let table = geo.table(8e-3, 2e-4);
+    for amp in [2e-3, 4e-3] {
+        let le = table.equivalent_conicity(amp).unwrap();
+        assert!((le / effective - 1.0).abs() < 0.01, "λe({amp}) = {le}");
+    }
+    // Table lookup between grid points agrees with a direct solve.
+    let (direct, looked) = (geo.solve(1.23e-3, 0.0), table.lookup(1.23e-3));
+    assert!((direct.roll - looked.roll).abs() < 1e-7);
+    assert!((direct.wheels[0].rolling_radius - looked.wheels[0].rolling_radius).abs() < 1e-7);
+}
+
+#[test]
+fn s1002_on_60kg_conicity_grows_toward_flange_contact() {
+    // The C80's default pair: S1002 on 60 kg/m at 1:40, gauge 1435 mm, back-to-back 1353 mm.
+    let geo = WheelsetGeometry::new(
+        profile::s1002(),
+        profile::rail_60kg(),
+        (1.0f64 / 40.0).atan(),
+        1.435,
+        1.353,
+        0.07,
+        0.42,
+    )
+    .unwrap();
+    let table = geo.table(10e-3, 2e-4);
+    let l2 = table.equivalent_conicity(2e-3).unwrap();
+    let l6 = table.equivalent_conicity(6e-3).unwrap();
+    assert!(l2 > 0.01 && l2 < 0.5, "λe(2 mm) {l2}");
+    assert!(l6 > l2, "λe(6 mm) {l6} ≤ λe(2 mm) {l2}");
+    // Δr is odd in y for symmetric profiles.
+    for y in [1e-3, 3e-3, 7e-3] {
+        assert!((table.delta_r(y) + table.delta_r(-y)).abs() < 1e-6);
+    }
+}
+
+fn write(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("railforce-prof-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn profile_files_load_and_bad_ones_fail_clearly() {
+    // Two-column CSV with a header, in mm.
+    let p = write(
+        "cone.csv",
+        "y_mm,z_mm\n-30,1.5\n-10,0.5\n10,-0.5\n30,-1.5\n",
+    );
+    let prof = profile::load(&p, LoadOptions::default()).unwrap();
+    assert!((prof.eval(0.0).0).abs() < 1e-9 && (prof.eval(20e-3).0 + 1e-3).abs() < 1e-9);
+    // Decreasing y is accepted (reversed); mirroring flips the slope.
+    let p = write("rev.txt", "30 -1.5\n10 -0.5\n-10 0.5\n-30 1.5\n");
+    let m = profile::load(&p, LoadOptions { mirror_y: true }).unwrap();
+    assert!((m.eval(20e-3).0 - 1e-3).abs() < 1e-9);
+    let cases = [
+        ("few.csv", "0,0\n1,0\n", "at least 4 points"),
+        ("nonmono.csv", "0,0\n1,0\n0.5,0\n2,0\n3,0\n", "monotonic"),
+        ("text.csv", "0,0\n1,0\nabc\n", "line 3"),
+        (
+            "noblock.prw",
+            "header.begin\n type = 1\nheader.end\n",
+            "point.begin",
+        ),
+        (
+            "badnum.prr",
+            "spline.begin\n point.begin\n 1.0 x\n point.end\n",
+            "bad number",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let p = write(name, text);
+        let e = profile::load(&p, LoadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(name) && e.contains(want), "{name}: {e}");
+    }
+}
