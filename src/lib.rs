@@ -8,6 +8,7 @@
 
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod contact;
 pub mod dsp;
 pub mod error;

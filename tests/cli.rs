@@ -90,3 +90,49 @@ fn bad_track_file_fails_with_file_and_field() {
     let (ok, _, err) = railforce(&["track", "no/such/file.toml"]);
     assert!(!ok && err.contains("no/such/file.toml"), "{err}");
 }
+
+#[test]
+fn contact_prints_both_wheels_and_flags_flange_contact() {
+    let (ok, out, err) = railforce(&["contact", "--y-mm", "2", "--yaw-mrad", "0.5"]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("left") && out.contains("right") && out.contains("xi_x"),
+        "{out}"
+    );
+    // Far to the left the left wheel runs on its flange: contact angle above 45°.
+    let (ok, out, _) = railforce(&["contact", "--y-mm", "12"]);
+    assert!(ok);
+    let left = out.lines().find(|l| l.starts_with("left ")).unwrap();
+    let angle: f64 = left.split_whitespace().nth(5).unwrap().parse().unwrap();
+    assert!(angle > 45.0, "{left}");
+    let (ok, _, err) = railforce(&["contact", "--law", "magic"]);
+    assert!(!ok && err.contains("--law"), "{err}");
+    let (ok, _, err) = railforce(&["contact", "--wheel", "nowhere.prw"]);
+    assert!(!ok && err.contains("nowhere.prw"), "{err}");
+}
+
+#[test]
+fn validate_contact_passes_on_the_reference_data() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/reference");
+    if !dir.exists() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "reference data missing in CI"
+        );
+        return;
+    }
+    let (ok, out, err) = railforce(&[
+        "validate",
+        "contact",
+        "--reference-dir",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{out}\n{err}");
+    assert!(
+        out.contains("all gated comparisons within tolerance"),
+        "{out}"
+    );
+    // A missing folder is a clear error, not a pass.
+    let (ok, _, err) = railforce(&["validate", "contact", "--reference-dir", "/no/such/dir"]);
+    assert!(!ok && err.contains("/no/such/dir"), "{err}");
+}

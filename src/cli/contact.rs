@@ -87,6 +87,9 @@ pub struct ContactArgs {
     /// Creep force law: polach, fastsim or linear.
     #[arg(long, default_value = "polach")]
     law: String,
+    /// Also print the equivalent conicity (EN 15302 integral method) for amplitudes 1–10 mm.
+    #[arg(long)]
+    conicity: bool,
 }
 
 pub fn run(args: ContactArgs) -> Result<()> {
@@ -183,5 +186,15 @@ pub fn run(args: ContactArgs) -> Result<()> {
     println!(
         "wheel_y: on the wheel profile from the tape circle (+ field side); rail_y: from the gauge point (+ field side)"
     );
+    if args.conicity {
+        let table = geo.table(15e-3, 1e-4);
+        println!("equivalent conicity (EN 15302 integral method):");
+        for amp_mm in [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0] {
+            match table.equivalent_conicity(amp_mm * 1e-3) {
+                Some(l) => println!("  amplitude {amp_mm:>4.1} mm: {l:.4}"),
+                None => println!("  amplitude {amp_mm:>4.1} mm: no oscillation found"),
+            }
+        }
+    }
     Ok(())
 }

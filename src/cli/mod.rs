@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch. Each subcommand lives in its own file and only turns
 //! arguments into library calls and library results into text.
 
+mod bench;
 mod contact;
 mod track;
 mod validate;
@@ -38,6 +39,8 @@ enum Command {
     Contact(contact::ContactArgs),
     /// Check railforce against reference solutions (`validate contact`).
     Validate(validate::ValidateArgs),
+    /// Built-in benchmarks with same-run references (`bench contact`).
+    Bench(bench::BenchArgs),
 }
 
 /// Parses the command line, runs the subcommand and turns errors into a message and exit 1.
@@ -47,6 +50,7 @@ pub fn main() -> ExitCode {
         Command::Track(args) => track::run(args),
         Command::Contact(args) => contact::run(args),
         Command::Validate(args) => validate::run(args),
+        Command::Bench(args) => bench::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -173,26 +173,28 @@ impl KalkerCoefficients {
     /// ratio `nu` (0 to ½). Ratios beyond the table (below 0.1 or above 10) are clamped.
     pub fn new(a_over_b: f64, nu: f64) -> Self {
         let nu = nu.clamp(0.0, 0.5);
-        // Position along one ordered list of rows: 0.1 … 1.0 (a/b), then b/a 0.9 … 0.1.
-        // Parametrise by t = a/b on the first part and by 2 − b/a on the second, both
-        // increasing with a/b.
-        let rows: Vec<(f64, [[f64; 3]; 4])> = TABLE_AB_LE_1
-            .iter()
-            .map(|r| (r.0, [r.1, r.2, r.3, r.4]))
-            .chain(
-                TABLE_AB_GT_1
-                    .iter()
-                    .map(|r| (2.0 - r.0, [r.1, r.2, r.3, r.4])),
-            )
-            .collect();
+        // One ordered list of rows, increasing with a/b: t = a/b on the first table (0.1 … 1)
+        // and t = 2 − b/a on the second (1.1 … 1.9).
+        let row = |i: usize| -> (f64, [[f64; 3]; 4]) {
+            let (c11, c22, c23, c33, t) = if i < TABLE_AB_LE_1.len() {
+                let r = TABLE_AB_LE_1[i];
+                (r.1, r.2, r.3, r.4, r.0)
+            } else {
+                let r = TABLE_AB_GT_1[i - TABLE_AB_LE_1.len()];
+                (r.1, r.2, r.3, r.4, 2.0 - r.0)
+            };
+            (t, [c11, c22, c23, c33])
+        };
+        let n_rows = TABLE_AB_LE_1.len() + TABLE_AB_GT_1.len();
         let t = if a_over_b <= 1.0 {
             a_over_b.max(0.1)
         } else {
             (2.0 - 1.0 / a_over_b).min(1.9)
         };
-        let i = rows.partition_point(|r| r.0 <= t).clamp(1, rows.len() - 1) - 1;
-        let (t0, v0) = rows[i];
-        let (t1, v1) = rows[i + 1];
+        // Rows are 0.1 apart in t from 0.1 to 1.9.
+        let i = (((t - 0.1) / 0.1) as usize).min(n_rows - 2);
+        let (t0, v0) = row(i);
+        let (t1, v1) = row(i + 1);
         let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
         let c = |k: usize| {
             let a = in_nu(v0[k], nu);
