@@ -14,7 +14,9 @@ pub mod dsp;
 pub mod error;
 pub mod io;
 pub mod plan;
+pub mod sim;
 pub mod track;
+pub mod vehicle;
 
 pub use error::{Error, Result};
 

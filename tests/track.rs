@@ -149,11 +149,34 @@ fn irregularities_do_not_repeat_within_the_track() {
 }
 
 #[test]
+fn irregularities_fade_in_from_a_smooth_start() {
+    let t = straight(500.0, 5, 1);
+    let irr = t.irregularities().unwrap();
+    // Defaults: 20 m smooth lead, then a 50 m raised-cosine fade-in.
+    for s in [0.0, 10.0, 20.0] {
+        let r = irr.rails_at(s);
+        assert_eq!(
+            (r.left_y, r.left_z, r.right_y, r.right_z),
+            (0.0, 0.0, 0.0, 0.0)
+        );
+    }
+    let (a, b) = (irr.rails_at(45.0), irr.raw_rails_at(45.0));
+    assert!(
+        (a.left_z - 0.5 * b.left_z).abs() < 1e-15,
+        "half way through the 50 m fade"
+    );
+    assert_eq!(irr.rails_at(71.0), irr.raw_rails_at(71.0));
+    let h = 1e-4;
+    let fd = (irr.rails_at(30.0 + h).left_z - irr.rails_at(30.0 - h).left_z) / (2.0 * h);
+    assert!((fd - irr.rails_at(30.0).left_z_ds).abs() < 1e-6);
+}
+
+#[test]
 fn rails_combine_channels_as_the_spec_says() {
     let t = straight(500.0, 5, 1);
     let irr = t.irregularities().unwrap();
     for s in [3.3, 101.7, 250.0] {
-        let r = irr.rails_at(s);
+        let r = irr.raw_rails_at(s);
         let zc = irr.channel_at(Channel::CrossLevel, s).0;
         let yg = irr.channel_at(Channel::Gauge, s).0;
         let zv = irr.channel_at(Channel::Vertical, s).0;
@@ -164,7 +187,7 @@ fn rails_combine_channels_as_the_spec_says() {
         assert!((0.5 * (r.left_y + r.right_y) - ya).abs() < 1e-15);
         // Derivative agrees with a finite difference of the interpolant.
         let h = 1e-4;
-        let fd = (irr.rails_at(s + h).left_y - irr.rails_at(s - h).left_y) / (2.0 * h);
+        let fd = (irr.raw_rails_at(s + h).left_y - irr.raw_rails_at(s - h).left_y) / (2.0 * h);
         assert!((fd - r.left_y_ds).abs() < 1e-6 * (1.0 + fd.abs()));
     }
 }

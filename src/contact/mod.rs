@@ -13,4 +13,6 @@ pub use geometry::{ContactState, ContactTable, Side, WheelContact, WheelsetGeome
 pub use hertz::{HertzEllipse, HertzShape, Material};
 pub use kalker::KalkerCoefficients;
 pub use profile::Profile;
-pub use wheel_rail::{WheelForce, WheelsetMotion, creepages, split_load, wheel_force};
+pub use wheel_rail::{
+    ContactFrame, WheelForce, WheelsetMotion, creepages, split_load, wheel_force,
+};

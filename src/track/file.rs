@@ -75,6 +75,18 @@ struct IrregularityFile {
     max_wavelength_m: f64,
     #[serde(default = "default_seed")]
     seed: u64,
+    #[serde(default = "default_smooth_start")]
+    smooth_start_m: f64,
+    #[serde(default = "default_fade_in")]
+    fade_in_m: f64,
+}
+
+fn default_smooth_start() -> f64 {
+    20.0
+}
+
+fn default_fade_in() -> f64 {
+    50.0
 }
 
 fn default_min_wavelength() -> f64 {
@@ -289,11 +301,21 @@ impl TrackSpec {
                         ),
                     ));
                 }
+                check_range(path, "irregularity.fade_in_m", irr.fade_in_m, 0.0, 1000.0)?;
+                check_range(
+                    path,
+                    "irregularity.smooth_start_m",
+                    irr.smooth_start_m,
+                    0.0,
+                    1000.0,
+                )?;
                 Some(IrregularitySpec {
+                    smooth_start: irr.smooth_start_m,
                     class,
                     min_wavelength: irr.min_wavelength_m,
                     max_wavelength: irr.max_wavelength_m,
                     seed: irr.seed,
+                    fade_in: irr.fade_in_m,
                 })
             }
         };

@@ -139,6 +139,11 @@ pub struct IrregularitySpec {
     pub max_wavelength: f64,
     /// Random seed of the phases.
     pub seed: u64,
+    /// Smooth lead at the start of the track where the rails have no irregularity, m.
+    pub smooth_start: f64,
+    /// Length over which the irregularities then fade in from zero (raised cosine), m:
+    /// vehicles start on smooth rails and settle onto the irregularities.
+    pub fade_in: f64,
 }
 
 /// Offsets of both rails at one position, m, with their derivatives along the track (1/1).
@@ -245,9 +250,43 @@ impl Irregularities {
         (val, der)
     }
 
+    /// Fade-in factor at `s` and its derivative: 0 on the smooth lead, then
+    /// `½(1 − cos(π·u/L))` over the fade-in length L (u measured from the end of the lead).
+    fn fade(&self, s: f64) -> (f64, f64) {
+        let l = self.spec.fade_in;
+        let s = s - self.spec.smooth_start;
+        if s <= 0.0 && (l > 0.0 || s < 0.0) {
+            (0.0, 0.0)
+        } else if l <= 0.0 || s >= l {
+            (1.0, 0.0)
+        } else if s <= 0.0 {
+            (0.0, 0.0)
+        } else {
+            let w = std::f64::consts::PI / l;
+            (0.5 * (1.0 - (w * s).cos()), 0.5 * w * (w * s).sin())
+        }
+    }
+
     /// Offsets of both rails at `s`: `z_L = z_v + z_c/2`, `z_R = z_v − z_c/2`,
-    /// `y_L = y_a + y_g/2`, `y_R = y_a − y_g/2`.
+    /// `y_L = y_a + y_g/2`, `y_R = y_a − y_g/2`, faded in over the first
+    /// [`IrregularitySpec::fade_in`] metres after a smooth lead.
     pub fn rails_at(&self, s: f64) -> RailIrregularity {
+        let (f, df) = self.fade(s);
+        let r = self.raw_rails_at(s);
+        RailIrregularity {
+            left_y: f * r.left_y,
+            left_z: f * r.left_z,
+            right_y: f * r.right_y,
+            right_z: f * r.right_z,
+            left_y_ds: f * r.left_y_ds + df * r.left_y,
+            left_z_ds: f * r.left_z_ds + df * r.left_z,
+            right_y_ds: f * r.right_y_ds + df * r.right_y,
+            right_z_ds: f * r.right_z_ds + df * r.right_z,
+        }
+    }
+
+    /// Rail offsets without the fade-in.
+    pub fn raw_rails_at(&self, s: f64) -> RailIrregularity {
         let (zv, zv_d) = self.channel_at(Channel::Vertical, s);
         let (ya, ya_d) = self.channel_at(Channel::Alignment, s);
         let (zc, zc_d) = self.channel_at(Channel::CrossLevel, s);

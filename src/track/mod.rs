@@ -121,6 +121,14 @@ impl Track {
         }
     }
 
+    /// Centre-line position `(x, y)`, heading and curvature at `s` only (cheaper than
+    /// [`Track::at`]: no profile, cant or irregularities).
+    pub fn centre_line(&self, s: f64) -> (f64, f64, f64, f64) {
+        let s = s.clamp(0.0, self.length());
+        let (x, y) = self.alignment.position(s);
+        (x, y, self.alignment.heading(s), self.alignment.curvature(s))
+    }
+
     /// Like [`Track::at`] but fails outside the track, for callers that must not run off it.
     pub fn try_at(&self, s: f64) -> Result<TrackPoint> {
         if !(0.0..=self.length()).contains(&s) {

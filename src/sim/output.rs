@@ -1,0 +1,371 @@
+//! Recorded signals: the paper's 21 sensor channels, the true forces of every wheel, and the
+//! same kinds of signals for every body, low-pass filtered at the integration rate and
+//! decimated to the output rate, streamed to a CSV file written atomically, with a metadata
+//! file beside it.
+//!
+//! Accelerations are what an accelerometer on the body reads: specific force `a − g` (so a body
+//! at rest reads +g vertically), in body axes; for wheelsets, which spin, in the axes of the
+//! local track frame (an axle-box accelerometer).
+
+use super::filter::Lowpass;
+use super::{Simulation, wheel_name};
+use crate::error::{Error, Result};
+use nalgebra::Vector3;
+use std::path::{Path, PathBuf};
+
+/// Names of the paper's 21 input channels, in order X1 … X21 (spec §5).
+pub const PAPER_CHANNELS: [&str; 21] = [
+    "frame_l_acc_y",
+    "frame_r_acc_y",
+    "frame_l_acc_z",
+    "frame_r_acc_z",
+    "bolster_acc_y",
+    "bolster_acc_z",
+    "ws1_acc_y",
+    "ws1_acc_z",
+    "ws1_y_rel",
+    "ws1_yaw",
+    "ws1_roll",
+    "body_roll_rate",
+    "body_pitch_rate",
+    "body_yaw_rate",
+    "ws1_roll_rate",
+    "ws1_pitch_rate",
+    "ws1_yaw_rate",
+    "ws1_attack_angle",
+    "w1l_creep_y",
+    "w1l_creep_x",
+    "w1l_creep_spin",
+];
+
+const PAPER_UNITS: [&str; 21] = [
+    "m/s2", "m/s2", "m/s2", "m/s2", "m/s2", "m/s2", "m/s2", "m/s2", "m", "rad", "rad", "rad/s",
+    "rad/s", "rad/s", "rad/s", "rad/s", "rad/s", "rad", "1", "1", "1/m",
+];
+
+const BODY_SIGNALS: [(&str, &str); 10] = [
+    ("acc_x", "m/s2"),
+    ("acc_y", "m/s2"),
+    ("acc_z", "m/s2"),
+    ("roll_rate", "rad/s"),
+    ("pitch_rate", "rad/s"),
+    ("yaw_rate", "rad/s"),
+    ("y_rel", "m"),
+    ("z_rel", "m"),
+    ("roll", "rad"),
+    ("yaw", "rad"),
+];
+
+const WHEEL_SIGNALS: [(&str, &str); 7] = [
+    ("force_y", "N"),
+    ("force_z", "N"),
+    ("normal", "N"),
+    ("angle", "rad"),
+    ("creep_x", "1"),
+    ("creep_y", "1"),
+    ("creep_spin", "1/m"),
+];
+
+/// Filters and decimates the signals of a simulation.
+pub struct Recorder {
+    names: Vec<String>,
+    units: Vec<&'static str>,
+    lowpass: Lowpass,
+    filter_state: Vec<[f64; 4]>,
+    every: usize,
+    count: usize,
+    row: Vec<f64>,
+    paper: bool,
+}
+
+impl Recorder {
+    /// Channels for this simulation's vehicle.
+    pub fn new(sim: &Simulation) -> Self {
+        let v = sim.vehicle();
+        let mut names: Vec<String> = vec!["time_s".into(), "s_m".into()];
+        let mut units = vec!["s", "m"];
+        let paper = v.sensors.is_some();
+        if paper {
+            names.extend(PAPER_CHANNELS.iter().map(|s| s.to_string()));
+            units.extend(PAPER_UNITS);
+        }
+        for k in 0..2 * v.contact.wheelsets.len() {
+            let w = wheel_name(k).to_ascii_lowercase();
+            for (s, u) in WHEEL_SIGNALS {
+                names.push(format!("w{w}_{s}"));
+                units.push(u);
+            }
+        }
+        for b in &v.bodies {
+            for (s, u) in BODY_SIGNALS {
+                names.push(format!("{}_{s}", b.name));
+                units.push(u);
+            }
+        }
+        let cfg = sim.config();
+        let every = (1.0 / (cfg.output_rate * cfg.dt)).round().max(1.0) as usize;
+        let n = names.len();
+        Recorder {
+            names,
+            units,
+            lowpass: Lowpass::new(cfg.cutoff, 1.0 / cfg.dt),
+            filter_state: vec![[0.0; 4]; n],
+            every,
+            count: 0,
+            row: vec![0.0; n],
+            paper,
+        }
+    }
+
+    /// Channel names, in column order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Units of the channels.
+    pub fn units(&self) -> &[&'static str] {
+        &self.units
+    }
+
+    /// Takes the signals of the current step; returns a decimated row when one is due.
+    /// The first call initialises the filters to the current values (no start transient).
+    pub fn sample(&mut self, sim: &Simulation) -> Option<&[f64]> {
+        signals(sim, self.paper, &mut self.row);
+        let first = self.count == 0;
+        for i in 2..self.row.len() {
+            if first {
+                self.filter_state[i] = self.lowpass.steady_state(self.row[i]);
+            }
+            self.row[i] = self.lowpass.step(self.row[i], &mut self.filter_state[i]);
+        }
+        let due = self.count.is_multiple_of(self.every);
+        self.count += 1;
+        due.then_some(&self.row[..])
+    }
+}
+
+/// Computes all channels of the current step into `out` (same order as the names).
+fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
+    let v = sim.vehicle();
+    let states = sim.states();
+    let g = Vector3::new(0.0, 0.0, crate::GRAVITY);
+    let mut body_vals: Vec<[f64; 10]> = Vec::with_capacity(states.len());
+    for (i, st) in states.iter().enumerate() {
+        let f = &sim.frames()[i];
+        let spec_force = sim.accelerations[i] + g;
+        let is_ws = v.contact.wheelsets.contains(&i);
+        let axes = if is_ws { f.axes } else { st.matrix() };
+        let a = axes.transpose() * spec_force;
+        let w = axes.transpose() * st.angular_velocity;
+        let rel = f.to_local(&(st.position - f.origin));
+        let rot_rel = f.axes.transpose() * st.matrix();
+        let y_axis = rot_rel.column(1);
+        body_vals.push([
+            a.x,
+            a.y,
+            a.z,
+            w.x,
+            w.y,
+            w.z,
+            rel.y,
+            rel.z,
+            y_axis.z.asin(),
+            (-y_axis.x).atan2(y_axis.y),
+        ]);
+    }
+    let mut k = 0;
+    let mut put = |x: f64| {
+        out[k] = x;
+        k += 1;
+    };
+    put(sim.time());
+    let s_centre = sim.body_s().iter().sum::<f64>() / sim.body_s().len() as f64;
+    put(s_centre);
+    if let Some(sl) = &v.sensors {
+        let ws_pos = v
+            .contact
+            .wheelsets
+            .iter()
+            .position(|&w| w == sl.wheelset)
+            .unwrap_or(0);
+        let wl = &sim.wheels[2 * ws_pos];
+        let (fl, fr, bo, cb, ws) = (
+            &body_vals[sl.frame_left],
+            &body_vals[sl.frame_right],
+            &body_vals[sl.bolster],
+            &body_vals[sl.carbody],
+            &body_vals[sl.wheelset],
+        );
+        for x in [
+            fl[1],
+            fr[1],
+            fl[2],
+            fr[2],
+            bo[1],
+            bo[2],
+            ws[1],
+            ws[2],
+            wl.y_centre,
+            wl.yaw,
+            wl.roll,
+            cb[3],
+            cb[4],
+            cb[5],
+            ws[3],
+            ws[4],
+            ws[5],
+            wl.yaw - wl.rail_slope,
+            wl.creepage.y,
+            wl.creepage.x,
+            wl.creepage.spin,
+        ] {
+            put(x);
+        }
+    }
+    for w in &sim.wheels {
+        for x in [
+            w.y,
+            w.q,
+            w.normal,
+            w.angle,
+            w.creepage.x,
+            w.creepage.y,
+            w.creepage.spin,
+        ] {
+            put(x);
+        }
+    }
+    for b in &body_vals {
+        for &x in b {
+            put(x);
+        }
+    }
+    let _ = paper;
+}
+
+/// What a finished run reports.
+#[derive(Debug, Clone)]
+pub struct RunSummary {
+    /// Rows written.
+    pub rows: usize,
+    /// Simulated time recorded, s.
+    pub simulated: f64,
+    /// Wall time of the whole run (settling included), s.
+    pub wall: f64,
+    /// Simulated time (settling included) over wall time.
+    pub real_time_factor: f64,
+    /// Peak |Y/Q| per wheel over the recorded part.
+    pub peak_y_over_q: Vec<f64>,
+    /// Mean Y and Q per wheel over the recorded part, N.
+    pub mean_yq: Vec<(f64, f64)>,
+    /// Output file.
+    pub out: PathBuf,
+}
+
+/// Runs a simulation: settles, records `duration` seconds, streams the rows into a CSV file
+/// (temporary file, renamed when complete) and writes `<out>.meta.json` beside it. `progress`
+/// receives the fraction done.
+pub fn run_to_csv(
+    sim: &mut Simulation,
+    out: &Path,
+    meta: &serde_json::Value,
+    mut progress: impl FnMut(f64),
+) -> Result<RunSummary> {
+    let t0 = std::time::Instant::now();
+    sim.settle()?;
+    let mut rec = Recorder::new(sim);
+    let duration = sim.config().duration;
+    let n_wheels = sim.wheels.len();
+    let mut peak = vec![0.0f64; n_wheels];
+    let mut sums = vec![(0.0, 0.0); n_wheels];
+    let mut steps = 0usize;
+    let mut rows = 0usize;
+    let total_steps = (duration / sim.config().dt).round() as usize;
+    let mut result: Result<()> = Ok(());
+    crate::io::write_atomic(out, |w| {
+        writeln!(w, "{}", rec.names().join(","))?;
+        while steps <= total_steps {
+            if steps > 0
+                && let Err(e) = sim.step()
+            {
+                result = Err(e);
+                return Err(std::io::Error::other("simulation stopped"));
+            }
+            for (k, wr) in sim.wheels.iter().enumerate() {
+                if wr.q > 1.0 {
+                    peak[k] = peak[k].max((wr.y / wr.q).abs());
+                }
+                sums[k].0 += wr.y;
+                sums[k].1 += wr.q;
+            }
+            if let Some(row) = rec.sample(sim) {
+                if row.iter().any(|x| !x.is_finite()) {
+                    result = Err(Error::Domain(format!(
+                        "non-finite signal at t = {:.4} s: nothing is written",
+                        sim.time()
+                    )));
+                    return Err(std::io::Error::other("non-finite"));
+                }
+                let mut first = true;
+                for x in row {
+                    if !first {
+                        w.write_all(b",")?;
+                    }
+                    first = false;
+                    write!(w, "{x:.7e}")?;
+                }
+                w.write_all(b"\n")?;
+                rows += 1;
+            }
+            steps += 1;
+            if steps.is_multiple_of(2000) {
+                progress(steps as f64 / total_steps.max(1) as f64);
+            }
+        }
+        Ok(())
+    })
+    .or_else(|e| match (&result, e) {
+        (Err(_), _) => Ok(()),
+        (Ok(()), e) => Err(e),
+    })?;
+    result?;
+    let wall = t0.elapsed().as_secs_f64();
+    let n = (steps.max(1)) as f64;
+    let summary = RunSummary {
+        rows,
+        simulated: duration,
+        wall,
+        real_time_factor: (duration + sim.config().settle) / wall,
+        peak_y_over_q: peak,
+        mean_yq: sums.iter().map(|&(y, q)| (y / n, q / n)).collect(),
+        out: out.to_path_buf(),
+    };
+    let mut meta = meta.clone();
+    if let Some(m) = meta.as_object_mut() {
+        m.insert(
+            "channels".into(),
+            rec.names()
+                .iter()
+                .zip(rec.units())
+                .map(|(n, u)| serde_json::json!({"name": n, "unit": u}))
+                .collect(),
+        );
+        m.insert("rows".into(), rows.into());
+        m.insert("wall_time_s".into(), wall.into());
+    }
+    let meta_path = meta_path(out);
+    crate::io::write_atomic(&meta_path, |w| {
+        serde_json::to_writer_pretty(&mut *w, &meta).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    })?;
+    Ok(summary)
+}
+
+/// `run.csv` → `run.meta.json`.
+pub fn meta_path(out: &Path) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "run".into());
+    out.with_file_name(format!("{stem}.meta.json"))
+}

@@ -1,0 +1,126 @@
+//! Force elements of the suspension, one file per kind. Each acts between two bodies through
+//! attachment points and adds equal and opposite forces (and torques) to their wrenches. Axes of
+//! an element are those of its upper body; displacements are those of the lower attachment
+//! relative to the upper one, zero in the static loaded position, where supporting elements
+//! carry their preload.
+
+mod centre_plate;
+mod cross_bracing;
+mod shear_pad;
+mod side_bearer;
+mod spring_nest;
+mod wedge_damper;
+
+pub use centre_plate::CentrePlate;
+pub use cross_bracing::CrossBracing;
+pub use shear_pad::ShearPad;
+pub use side_bearer::SideBearer;
+pub use spring_nest::{NestLaw, SpringNest};
+pub use wedge_damper::WedgeDamper;
+
+use super::body::{Attachment, BodyState, Wrench};
+use nalgebra::{Matrix3, Vector3};
+
+/// Any force element.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Element {
+    /// Axle-box rubber shear pad (side frame ↔ wheelset).
+    ShearPad(ShearPad),
+    /// Two-stage spring nest (bolster ↔ side frame).
+    SpringNest(SpringNest),
+    /// Wedge friction damper (bolster ↔ side frame).
+    WedgeDamper(WedgeDamper),
+    /// Centre plate (carbody ↔ bolster).
+    CentrePlate(CentrePlate),
+    /// Constant-contact side bearer (carbody ↔ bolster).
+    SideBearer(SideBearer),
+    /// Cross-bracing between the two side frames of a bogie.
+    CrossBracing(CrossBracing),
+}
+
+impl Element {
+    /// Adds this element's forces to the wrenches of the bodies it connects.
+    #[inline]
+    pub fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
+        match self {
+            Element::ShearPad(e) => e.apply(states, wrenches),
+            Element::SpringNest(e) => e.apply(states, wrenches),
+            Element::WedgeDamper(e) => e.apply(states, wrenches),
+            Element::CentrePlate(e) => e.apply(states, wrenches),
+            Element::SideBearer(e) => e.apply(states, wrenches),
+            Element::CrossBracing(e) => e.apply(states, wrenches),
+        }
+    }
+
+    /// Kind name as in the vehicle file.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Element::ShearPad(_) => "shear_pad",
+            Element::SpringNest(_) => "spring_nest",
+            Element::WedgeDamper(_) => "wedge_damper",
+            Element::CentrePlate(_) => "centre_plate",
+            Element::SideBearer(_) => "side_bearer",
+            Element::CrossBracing(_) => "cross_bracing",
+        }
+    }
+}
+
+/// Relative motion across a two-point element, in the upper body's axes.
+pub(crate) struct Relative {
+    /// Upper body axes.
+    pub axes: Matrix3<f64>,
+    /// Displacement of the lower attachment relative to the upper, upper axes.
+    pub d: Vector3<f64>,
+    /// Velocity of the lower attachment relative to the upper, upper axes.
+    pub v: Vector3<f64>,
+    /// World positions of the two attachments.
+    pub p_upper: Vector3<f64>,
+    /// See `p_upper`.
+    pub p_lower: Vector3<f64>,
+}
+
+impl Relative {
+    #[inline]
+    pub fn new(upper: &Attachment, lower: &Attachment, states: &[BodyState]) -> Self {
+        let (su, sl) = (&states[upper.body], &states[lower.body]);
+        let axes = su.matrix();
+        let p_upper = su.point(&upper.local);
+        let p_lower = sl.point(&lower.local);
+        let d = axes.transpose() * (p_lower - p_upper);
+        let v =
+            axes.transpose() * (sl.point_velocity(&lower.local) - su.point_velocity(&upper.local));
+        Relative {
+            axes,
+            d,
+            v,
+            p_upper,
+            p_lower,
+        }
+    }
+
+    /// Applies `f_upper_local` (upper axes) to the upper body and its opposite to the lower.
+    #[inline]
+    pub fn apply(
+        &self,
+        f_upper_local: Vector3<f64>,
+        upper: &Attachment,
+        lower: &Attachment,
+        states: &[BodyState],
+        wrenches: &mut [Wrench],
+    ) {
+        let f = self.axes * f_upper_local;
+        wrenches[upper.body].add_at(f, self.p_upper, states[upper.body].position);
+        wrenches[lower.body].add_at(-f, self.p_lower, states[lower.body].position);
+    }
+}
+
+/// Smooth friction direction factor `tanh(|v|/v_ref)·v/|v|` (a regularised sign, spec §2).
+#[inline]
+pub(crate) fn friction_dir(v: Vector3<f64>, v_ref: f64) -> Vector3<f64> {
+    let n = v.norm();
+    if n < 1e-12 {
+        Vector3::zeros()
+    } else {
+        v * ((n / v_ref).tanh() / n)
+    }
+}

@@ -1,0 +1,30 @@
+//! Axle-box rubber shear pad: linear spring–damper in three directions.
+
+use super::Relative;
+use crate::vehicle::body::{Attachment, BodyState, Wrench};
+use nalgebra::Vector3;
+
+/// Shear pad between a side frame (upper) and a wheelset's axle box (lower).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShearPad {
+    /// Side frame.
+    pub upper: Attachment,
+    /// Axle box: a point on the axle's axis, so the wheelset's spin does not move it.
+    pub lower: Attachment,
+    /// Stiffness (x, y, z), N/m.
+    pub stiffness: Vector3<f64>,
+    /// Damping (x, y, z), N·s/m.
+    pub damping: Vector3<f64>,
+    /// Static vertical load carried, N.
+    pub preload: f64,
+}
+
+impl ShearPad {
+    pub(crate) fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
+        let r = Relative::new(&self.upper, &self.lower, states);
+        let f = self.stiffness.component_mul(&r.d)
+            + self.damping.component_mul(&r.v)
+            + Vector3::new(0.0, 0.0, self.preload);
+        r.apply(f, &self.upper, &self.lower, states, wrenches);
+    }
+}
