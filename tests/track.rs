@@ -234,6 +234,22 @@ fn geometry_is_continuous_through_every_transition() {
 }
 
 #[test]
+fn interpolated_position_matches_quadrature() {
+    for file in ["curve_r400.toml", "grade10_L80.toml"] {
+        let t = Track::load(&tracks_dir().join(file)).unwrap();
+        let mut s = 0.0;
+        while s < t.length() {
+            let (a, b) = (t.alignment().position(s), t.alignment().position_exact(s));
+            assert!(
+                (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9,
+                "{file} at {s}"
+            );
+            s += 0.37;
+        }
+    }
+}
+
+#[test]
 fn curve_geometry_cant_ramp_and_balance_speed() {
     let t = Track::load(&tracks_dir().join("curve_r400.toml")).unwrap();
     let spec = t.spec();

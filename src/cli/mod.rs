@@ -3,6 +3,7 @@
 
 mod bench;
 mod contact;
+mod simulate;
 mod track;
 mod validate;
 
@@ -37,6 +38,14 @@ enum Command {
     /// law. Forces are those of the rail on the wheel: Fx, Fy in the contact plane; Y (+ left)
     /// and Q (+ up) in the track frame.
     Contact(contact::ContactArgs),
+    /// Simulate a vehicle on a track and record the 21 sensor channels, the forces of every
+    /// wheel and the motion of every body at 200 Hz.
+    ///
+    /// The run starts from static equilibrium, settles (not recorded), then records. A
+    /// diverging run or a derailment (flange climb, or |Y/Q| above Nadal's limit for more
+    /// than 50 ms) stops with a message naming the time and the wheel or body; nothing
+    /// non-finite is ever written, and the CSV appears only when complete.
+    Simulate(simulate::SimulateArgs),
     /// Check railforce against reference solutions (`validate contact`).
     Validate(validate::ValidateArgs),
     /// Built-in benchmarks with same-run references (`bench contact`).
@@ -49,6 +58,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Track(args) => track::run(args),
         Command::Contact(args) => contact::run(args),
+        Command::Simulate(args) => simulate::run(args),
         Command::Validate(args) => validate::run(args),
         Command::Bench(args) => bench::run(args),
     };

@@ -25,12 +25,112 @@ enum What {
         #[arg(long, default_value = "../shared/reference")]
         reference_dir: PathBuf,
     },
+    /// The simulator's physics checks (spec §6): static wheel loads, quasi-static curving
+    /// forces on R 400 m at 60 km/h and R 800 m at 100 km/h, and Klingel's wavelength of a
+    /// free wheelset. Prints measured against expected; exits non-zero on a miss.
+    Dynamics {
+        /// Vehicle for the static and curving checks.
+        #[arg(long, default_value = "vehicles/c80.toml")]
+        vehicle: PathBuf,
+        /// Single free wheelset for the Klingel check.
+        #[arg(long, default_value = "vehicles/single_wheelset.toml")]
+        wheelset: PathBuf,
+    },
 }
 
 pub fn run(args: ValidateArgs) -> Result<()> {
     match args.what {
         What::Contact { reference_dir } => contact(&reference_dir),
+        What::Dynamics { vehicle, wheelset } => dynamics(&vehicle, &wheelset),
     }
+}
+
+fn dynamics(vehicle: &std::path::Path, wheelset: &std::path::Path) -> Result<()> {
+    use railforce::sim::checks;
+    let v = railforce::vehicle::Vehicle::load(vehicle)?;
+    let mut misses = 0;
+    let mut verdict = |ok: bool| {
+        if !ok {
+            misses += 1;
+        }
+        if ok { "yes" } else { "MISS" }
+    };
+    println!("Static loads at rest on level tangent track ({}):", v.name);
+    let st = checks::static_loads(&v, 1.0)?;
+    let worst = st
+        .loads
+        .iter()
+        .map(|q| (q / st.expected - 1.0).abs())
+        .fold(0.0f64, f64::max);
+    println!(
+        "  wheel loads {:.2}–{:.2} kN, expected {:.2} kN ± 1 %: worst {:.3} %  {}",
+        st.loads.iter().cloned().fold(f64::MAX, f64::min) * 1e-3,
+        st.loads.iter().cloned().fold(f64::MIN, f64::max) * 1e-3,
+        st.expected * 1e-3,
+        worst * 100.0,
+        verdict(worst < 0.01)
+    );
+    println!(
+        "  ΣQ / M·g = {:.5} (within 0.1 %)  {}",
+        st.sum_ratio,
+        verdict((st.sum_ratio - 1.0).abs() < 1e-3)
+    );
+    println!(
+        "Quasi-static curving (mean over 250 m of circular curve; FRA class 6 irregularities keep the friction elements from sticking):"
+    );
+    for (file, kmh) in [
+        ("tracks/curve_r400.toml", 60.0),
+        ("tracks/curve_r800.toml", 100.0),
+    ] {
+        let track = checks::with_class(std::path::Path::new(file), 6)?;
+        let c = checks::curving(&v, &track, kmh / 3.6, 250.0)?;
+        let dev = (c.sum_y - c.expected_y).abs() / c.expected_y.abs();
+        let a_nc = (kmh / 3.6f64).powi(2) / c.radius - railforce::GRAVITY * c.cant_angle.tan();
+        let outer_more = (c.outer_inner_q.0 > c.outer_inner_q.1) == (a_nc > 0.0);
+        println!(
+            "  R {:.0} m, {:.0} mm cant, {kmh} km/h: ΣY {:+.2} kN vs {:+.2} kN ({:.2} %, allowance 3 %)  {}",
+            c.radius,
+            c.cant_angle.sin() * 1500.0,
+            c.sum_y * 1e-3,
+            c.expected_y * 1e-3,
+            dev * 100.0,
+            verdict(dev < 0.03)
+        );
+        println!(
+            "      ΣQ {:.2} kN vs {:.2} kN ({:.3} %)  {}",
+            c.sum_q * 1e-3,
+            c.expected_q * 1e-3,
+            (c.sum_q / c.expected_q - 1.0).abs() * 100.0,
+            verdict((c.sum_q / c.expected_q - 1.0).abs() < 0.005)
+        );
+        println!(
+            "      leading wheelset outer / inner Q {:.1} / {:.1} kN (a_nc {:+.2} m/s²: the {} wheel carries more)  {}",
+            c.outer_inner_q.0 * 1e-3,
+            c.outer_inner_q.1 * 1e-3,
+            a_nc,
+            if a_nc > 0.0 { "outer" } else { "inner" },
+            verdict(outer_more)
+        );
+    }
+    let w = railforce::vehicle::Vehicle::load(wheelset)?;
+    let k = checks::klingel(&w, 5.0, 2e-3, 4)?;
+    let dev = (k.measured / k.expected - 1.0).abs();
+    println!("Klingel, free wheelset ({}), 5 m/s, 2 mm start:", w.name);
+    println!(
+        "  λe {:.4}, r0 {:.4} m, b0 {:.4} m: wavelength {:.3} m vs 2π·sqrt(r0·b0/λe) = {:.3} m ({:.2} %, within 1 %)  {}",
+        k.conicity,
+        k.r0,
+        k.b0,
+        k.measured,
+        k.expected,
+        dev * 100.0,
+        verdict(dev < 0.01)
+    );
+    if misses > 0 {
+        bail!("{misses} check(s) missed");
+    }
+    println!("all dynamics checks passed");
+    Ok(())
 }
 
 fn contact(dir: &std::path::Path) -> Result<()> {

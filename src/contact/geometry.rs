@@ -406,12 +406,29 @@ impl WheelsetGeometry {
         }
     }
 
-    /// Precomputes contact states over `y ∈ [−y_max, y_max]` every `dy` at zero yaw.
+    /// Precomputes contact states over `y ∈ [−y_max, y_max]` every `dy` at zero yaw, on all
+    /// cores (each shift is solved on its own, so the result does not depend on the threads).
     pub fn table(&self, y_max: f64, dy: f64) -> ContactTable {
         let n = (y_max / dy).round() as usize;
-        let states = (0..=2 * n)
-            .map(|i| self.solve((i as f64 - n as f64) * dy, 0.0))
-            .collect();
+        let ys: Vec<f64> = (0..=2 * n).map(|i| (i as f64 - n as f64) * dy).collect();
+        let threads = std::thread::available_parallelism()
+            .map(|p| p.get())
+            .unwrap_or(1)
+            .min(ys.len());
+        let chunk = ys.len().div_ceil(threads.max(1));
+        let states: Vec<ContactState> = std::thread::scope(|scope| {
+            let handles: Vec<_> = ys
+                .chunks(chunk)
+                .map(|part| {
+                    scope
+                        .spawn(move || part.iter().map(|&y| self.solve(y, 0.0)).collect::<Vec<_>>())
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().expect("contact solve thread"))
+                .collect()
+        });
         ContactTable {
             y_min: -(n as f64) * dy,
             dy,

@@ -56,14 +56,15 @@ const BODY_SIGNALS: [(&str, &str); 10] = [
     ("yaw", "rad"),
 ];
 
+// Per-wheel creepages are named xi_* so they never clash with the paper's w1l_creep_* inputs.
 const WHEEL_SIGNALS: [(&str, &str); 7] = [
     ("force_y", "N"),
     ("force_z", "N"),
     ("normal", "N"),
     ("angle", "rad"),
-    ("creep_x", "1"),
-    ("creep_y", "1"),
-    ("creep_spin", "1/m"),
+    ("xi_x", "1"),
+    ("xi_y", "1"),
+    ("xi_spin", "1/m"),
 ];
 
 /// Filters and decimates the signals of a simulation.
@@ -129,7 +130,9 @@ impl Recorder {
 
     /// Takes the signals of the current step; returns a decimated row when one is due.
     /// The first call initialises the filters to the current values (no start transient).
-    pub fn sample(&mut self, sim: &Simulation) -> Option<&[f64]> {
+    pub fn sample(&mut self, sim: &mut Simulation) -> Option<&[f64]> {
+        sim.refresh_frames();
+        let sim = &*sim;
         signals(sim, self.paper, &mut self.row);
         let first = self.count == 0;
         for i in 2..self.row.len() {
@@ -280,6 +283,13 @@ pub fn run_to_csv(
     let mut sums = vec![(0.0, 0.0); n_wheels];
     let mut steps = 0usize;
     let mut rows = 0usize;
+    let wheel_col = rec
+        .names()
+        .iter()
+        .position(|n| n == "w1l_force_y")
+        .unwrap_or(2);
+    let static_load =
+        sim.vehicle().mass() * crate::GRAVITY / sim.vehicle().contact.wheelsets.len() as f64 / 2.0;
     let total_steps = (duration / sim.config().dt).round() as usize;
     let mut result: Result<()> = Ok(());
     crate::io::write_atomic(out, |w| {
@@ -292,13 +302,18 @@ pub fn run_to_csv(
                 return Err(std::io::Error::other("simulation stopped"));
             }
             for (k, wr) in sim.wheels.iter().enumerate() {
-                if wr.q > 1.0 {
-                    peak[k] = peak[k].max((wr.y / wr.q).abs());
-                }
                 sums[k].0 += wr.y;
                 sums[k].1 += wr.q;
             }
-            if let Some(row) = rec.sample(sim) {
+            if let Some(row) = rec.sample(&mut *sim) {
+                // Y/Q from the recorded (filtered) forces, where the wheel carries at least
+                // 10 % of its static load (Y/Q of an unloaded wheel means nothing).
+                for (k, p) in peak.iter_mut().enumerate() {
+                    let (y, q) = (row[wheel_col + 7 * k], row[wheel_col + 7 * k + 1]);
+                    if q > 0.1 * static_load {
+                        *p = p.max((y / q).abs());
+                    }
+                }
                 if row.iter().any(|x| !x.is_finite()) {
                     result = Err(Error::Domain(format!(
                         "non-finite signal at t = {:.4} s: nothing is written",

@@ -166,6 +166,21 @@ pub struct ContactSettings {
     pub material: Material,
     /// Damping ratio of the normal contact.
     pub damping_ratio: f64,
+    /// Contact table, built on first use and shared by every run of this vehicle.
+    table: std::sync::OnceLock<crate::contact::ContactTable>,
+}
+
+impl ContactSettings {
+    /// Half-range of the contact table in lateral shift, m.
+    pub const TABLE_RANGE: f64 = 40e-3;
+    /// Step of the contact table, m.
+    pub const TABLE_STEP: f64 = 1e-4;
+
+    /// The contact table over ±40 mm every 0.1 mm (built once, on first use).
+    pub fn table(&self) -> &crate::contact::ContactTable {
+        self.table
+            .get_or_init(|| self.geometry.table(Self::TABLE_RANGE, Self::TABLE_STEP))
+    }
 }
 
 /// Speed control that stands for the rest of the train.
@@ -538,6 +553,7 @@ impl Vehicle {
                     poisson: c.poisson,
                 },
                 damping_ratio: c.damping_ratio,
+                table: std::sync::OnceLock::new(),
             },
             hauling,
             sensors,

@@ -1,0 +1,270 @@
+//! Vehicle files and the simulator: static equilibrium, reproducibility, failure detection,
+//! and (ignored, run by CI in release) quasi-static curving and Klingel's wavelength.
+
+use railforce::sim::{SimConfig, Simulation, checks, output};
+use railforce::track::{Track, TrackSpec};
+use railforce::vehicle::{Element, Vehicle};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The C80, loaded once per test binary (its contact table is built on first use).
+fn c80() -> &'static Vehicle {
+    static V: OnceLock<Vehicle> = OnceLock::new();
+    V.get_or_init(|| Vehicle::load(&root().join("vehicles/c80.toml")).unwrap())
+}
+
+#[test]
+fn c80_has_eleven_bodies_of_100_t_and_its_elements() {
+    let v = c80();
+    assert_eq!(v.bodies.len(), 11);
+    assert!((v.mass() - 100_000.0).abs() < 1e-6);
+    let count = |k: &str| v.elements.iter().filter(|e| e.kind() == k).count();
+    assert_eq!(count("shear_pad"), 8);
+    assert_eq!(count("spring_nest"), 4);
+    assert_eq!(count("wedge_damper"), 4);
+    assert_eq!(count("centre_plate"), 2);
+    assert_eq!(count("side_bearer"), 4);
+    assert_eq!(count("cross_bracing"), 2);
+    // The static load path: pads carry everything above the wheelsets.
+    let pads: f64 = v
+        .elements
+        .iter()
+        .filter_map(|e| match e {
+            Element::ShearPad(p) => Some(p.preload),
+            _ => None,
+        })
+        .sum();
+    let above_wheelsets = (100_000.0 - 4.0 * 1300.0) * railforce::GRAVITY;
+    assert!((pads / above_wheelsets - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn static_equilibrium_each_wheel_carries_an_eighth() {
+    let st = checks::static_loads(c80(), 0.5).unwrap();
+    assert!((st.expected - 122_625.0).abs() < 1.0);
+    for (k, q) in st.loads.iter().enumerate() {
+        assert!((q / st.expected - 1.0).abs() < 0.01, "wheel {k}: {q} N");
+    }
+    assert!(
+        (st.sum_ratio - 1.0).abs() < 1e-3,
+        "ΣQ/Mg = {}",
+        st.sum_ratio
+    );
+}
+
+#[test]
+fn same_seed_same_bytes_and_labels_written() {
+    let dir = std::env::temp_dir().join(format!("railforce-sim-{}", std::process::id()));
+    let track = |seed| {
+        Track::new(
+            TrackSpec::load(&root().join("tracks/tangent.toml")).unwrap(),
+            Some(seed),
+        )
+    };
+    let run = |seed: u64, name: &str| {
+        let t = track(seed);
+        let cfg = SimConfig {
+            speed: 80.0 / 3.6,
+            duration: 0.5,
+            settle: 0.2,
+            start: Some(40.0),
+            ..SimConfig::default()
+        };
+        let mut sim = Simulation::new(c80(), &t, cfg).unwrap();
+        let out = dir.join(name);
+        let summary =
+            output::run_to_csv(&mut sim, &out, &serde_json::json!({"seed": seed}), |_| {}).unwrap();
+        assert_eq!(summary.rows, 101, "0.5 s at 200 Hz, both ends");
+        std::fs::read(out).unwrap()
+    };
+    let (a, b, c) = (run(3, "a.csv"), run(3, "b.csv"), run(4, "c.csv"));
+    assert_eq!(a, b, "same seed, same bytes");
+    assert_ne!(a, c, "another seed, other irregularities");
+    let text = String::from_utf8(a).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    for name in [
+        "frame_l_acc_y",
+        "w1l_creep_spin",
+        "w1l_force_y",
+        "w1l_force_z",
+        "w4r_force_z",
+        "carbody_acc_z",
+    ] {
+        assert!(header.contains(&name), "missing {name}");
+    }
+    let unique: std::collections::HashSet<&&str> = header.iter().collect();
+    assert_eq!(unique.len(), header.len(), "column names are unique");
+    let meta = std::fs::read_to_string(dir.join("a.meta.json")).unwrap();
+    assert!(meta.contains("\"channels\"") && meta.contains("w1l_force_z"));
+    // Every value is finite and the vertical label is near the static load.
+    let idx = header.iter().position(|h| *h == "w1l_force_z").unwrap();
+    for line in text.lines().skip(1) {
+        let vals: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        assert!(vals.iter().all(|v| v.is_finite()));
+        assert!(vals[idx] > 60e3 && vals[idx] < 200e3, "Q1L {}", vals[idx]);
+    }
+}
+
+#[test]
+fn too_short_a_track_is_refused_before_running() {
+    let t = Track::load(&root().join("tracks/tangent.toml")).unwrap();
+    let cfg = SimConfig {
+        speed: 100.0 / 3.6,
+        duration: 100.0,
+        ..SimConfig::default()
+    };
+    let err = Simulation::new(c80(), &t, cfg).err().unwrap().to_string();
+    assert!(err.contains("tangent") && err.contains("m long"), "{err}");
+}
+
+#[test]
+fn flange_climb_is_reported_as_derailment() {
+    // A free wheelset started 40 mm off centre rides on its flange at once.
+    let w = Vehicle::load(&root().join("vehicles/single_wheelset.toml")).unwrap();
+    let track = Track::new(
+        TrackSpec::parse(
+            "[[section]]\nkind = \"tangent\"\nlength_m = 300\n",
+            Path::new("flat.toml"),
+        )
+        .unwrap(),
+        None,
+    );
+    let cfg = SimConfig {
+        speed: 10.0,
+        duration: 5.0,
+        settle: 0.0,
+        initial_offset: 0.034,
+        ..SimConfig::default()
+    };
+    let mut sim = Simulation::new(&w, &track, cfg).unwrap();
+    let mut err = None;
+    for _ in 0..25_000 {
+        if let Err(e) = sim.step() {
+            err = Some(e.to_string());
+            break;
+        }
+    }
+    let err = err.expect("a derailment is detected");
+    assert!(err.contains("derail") && err.contains("wheel 1"), "{err}");
+}
+
+#[test]
+fn nadal_limit_of_the_spec() {
+    let cfg = SimConfig::default();
+    assert!((cfg.nadal_limit(0.3) - 1.342).abs() < 1e-3);
+}
+
+fn write_vehicle(
+    name: &str,
+    toml_edit: impl Fn(String) -> String,
+    urdf_edit: impl Fn(String) -> String,
+) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("railforce-veh-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = std::fs::read_to_string(root().join("vehicles/c80.toml")).unwrap();
+    let urdf = std::fs::read_to_string(root().join("vehicles/c80.urdf")).unwrap();
+    std::fs::write(dir.join("c80.urdf"), urdf_edit(urdf)).unwrap();
+    let path = dir.join("c80.toml");
+    std::fs::write(&path, toml_edit(toml)).unwrap();
+    path
+}
+
+#[test]
+fn bad_vehicle_files_name_file_and_element() {
+    let id = |s: String| s;
+    let cases: Vec<(PathBuf, &str)> = vec![
+        (
+            write_vehicle(
+                "link",
+                |t| t.replacen("lower = \"wheelset1\"", "lower = \"wheelset9\"", 1),
+                id,
+            ),
+            "shear_pad[0].lower: unknown link \"wheelset9\"",
+        ),
+        (
+            write_vehicle(
+                "stiff",
+                |t| t.replacen("stiffness = [10.0e6,", "stiffness = [-10.0e6,", 1),
+                id,
+            ),
+            "shear_pad[0].stiffness: must not be negative",
+        ),
+        (
+            write_vehicle("mass", id, |u| {
+                u.replacen("<mass value=\"650.0\"/>", "<mass value=\"-650.0\"/>", 1)
+            }),
+            "link \"bolster1\".mass: must be positive",
+        ),
+        (
+            write_vehicle("inertia", id, |u| {
+                u.replacen("iyy=\"50.0\"", "iyy=\"0\"", 1)
+            }),
+            "link \"bolster1\".inertia.iyy: must be positive",
+        ),
+        (
+            write_vehicle(
+                "key",
+                |t| t.replacen("[hauling]", "[hauling]\ngain = 3", 1),
+                id,
+            ),
+            "unknown field",
+        ),
+        (
+            write_vehicle(
+                "law",
+                |t| t.replacen("creep_law = \"polach\"", "creep_law = \"magic\"", 1),
+                id,
+            ),
+            "contact.creep_law",
+        ),
+    ];
+    for (path, want) in cases {
+        let e = Vehicle::load(&path).unwrap_err().to_string();
+        assert!(e.contains(want), "expected '{want}' in: {e}");
+        assert!(
+            e.contains("c80.toml") || e.contains("c80.urdf"),
+            "no file named: {e}"
+        );
+    }
+}
+
+/// Quasi-static curving within 3 % of Newton's law (release: `cargo test --release -- --ignored`).
+#[test]
+#[ignore = "long simulation: run in release"]
+fn quasi_static_curving_matches_newton() {
+    for (file, kmh) in [
+        ("tracks/curve_r400.toml", 60.0),
+        ("tracks/curve_r800.toml", 100.0),
+    ] {
+        let track = checks::with_class(&root().join(file), 6).unwrap();
+        let c = checks::curving(c80(), &track, kmh / 3.6, 250.0).unwrap();
+        assert!(c.samples > 1000);
+        assert!(
+            ((c.sum_y - c.expected_y) / c.expected_y).abs() < 0.03,
+            "{file}: ΣY {} vs {}",
+            c.sum_y,
+            c.expected_y
+        );
+        assert!((c.sum_q / c.expected_q - 1.0).abs() < 0.005);
+        let a_nc = (kmh / 3.6f64).powi(2) / c.radius - railforce::GRAVITY * c.cant_angle.tan();
+        assert_eq!(c.outer_inner_q.0 > c.outer_inner_q.1, a_nc > 0.0);
+    }
+}
+
+/// Klingel's wavelength of a free wheelset on 1:40 cones within 1 %.
+#[test]
+#[ignore = "long simulation: run in release"]
+fn free_wheelset_klingel_wavelength() {
+    let w = Vehicle::load(&root().join("vehicles/single_wheelset.toml")).unwrap();
+    let k = checks::klingel(&w, 5.0, 2e-3, 4).unwrap();
+    assert!(
+        (k.measured / k.expected - 1.0).abs() < 0.01,
+        "{} m vs {} m",
+        k.measured,
+        k.expected
+    );
+}
