@@ -71,7 +71,6 @@ fn same_seed_same_bytes_and_labels_written() {
             speed: 80.0 / 3.6,
             duration: 0.5,
             settle: 0.2,
-            start: Some(40.0),
             ..SimConfig::default()
         };
         let mut sim = Simulation::new(c80(), &t, cfg).unwrap();
@@ -267,4 +266,39 @@ fn free_wheelset_klingel_wavelength() {
         k.measured,
         k.expected
     );
+}
+
+/// Tangent track at 100 km/h with FRA class 5 irregularities: a full 60 s run stays on the
+/// rails, keeps |Y/Q| far below Nadal and the wheelsets within the flangeway.
+#[test]
+#[ignore = "long simulation: run in release"]
+fn tangent_100_kmh_class_5_runs_without_derailment() {
+    let track = Track::load(&root().join("tracks/tangent.toml")).unwrap();
+    let cfg = SimConfig {
+        speed: 100.0 / 3.6,
+        duration: 60.0,
+        ..SimConfig::default()
+    };
+    let mut sim = Simulation::new(c80(), &track, cfg).unwrap();
+    sim.settle().unwrap();
+    let steps = (60.0 / sim.config().dt) as usize;
+    // Y/Q over 10 ms means (the impacts of single steps are not what Nadal's limit is for).
+    let mut peak_yq: f64 = 0.0;
+    let mut sums = vec![(0.0, 0.0); sim.wheels.len()];
+    for i in 0..steps {
+        sim.step().unwrap();
+        for (s, w) in sums.iter_mut().zip(&sim.wheels) {
+            s.0 += w.y;
+            s.1 += w.q;
+        }
+        if (i + 1) % 50 == 0 {
+            for s in &mut sums {
+                if s.1 > 50.0 * 20e3 {
+                    peak_yq = peak_yq.max((s.0 / s.1).abs());
+                }
+                *s = (0.0, 0.0);
+            }
+        }
+    }
+    assert!(peak_yq < 0.8, "peak |Y/Q| {peak_yq}");
 }

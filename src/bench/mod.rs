@@ -2,3 +2,4 @@
 //! same run, and reports the ratio, so figures compare across machines.
 
 pub mod contact;
+pub mod simulate;

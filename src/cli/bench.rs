@@ -19,10 +19,61 @@ enum What {
         #[arg(long, default_value_t = 2_000_000)]
         iterations: usize,
     },
+    /// The full C80 on tangent track with FRA class 5 irregularities and profile contact: wall
+    /// time per integration step and real-time factor, physics only and with every channel
+    /// filtered and sampled (one thread).
+    Simulate {
+        /// Vehicle file.
+        #[arg(long, default_value = "vehicles/c80.toml")]
+        vehicle: std::path::PathBuf,
+        /// Track file.
+        #[arg(long, default_value = "tracks/tangent.toml")]
+        track: std::path::PathBuf,
+        /// Speed, km/h.
+        #[arg(long, default_value_t = 80.0)]
+        speed_kmh: f64,
+        /// Simulated seconds per measurement.
+        #[arg(long, default_value_t = 20.0)]
+        seconds: f64,
+    },
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
     match args.what {
+        What::Simulate {
+            vehicle,
+            track,
+            speed_kmh,
+            seconds,
+        } => {
+            if cfg!(debug_assertions) {
+                eprintln!("warning: debug build; use `cargo run --release -- bench simulate`");
+            }
+            let v = railforce::vehicle::Vehicle::load(&vehicle)?;
+            let t0 = std::time::Instant::now();
+            v.contact.table();
+            let table_s = t0.elapsed().as_secs_f64();
+            let tr = railforce::track::Track::load(&track)?;
+            let b = railforce::bench::simulate::run(&v, &tr, speed_kmh / 3.6, seconds)?;
+            println!(
+                "simulation benchmark: {} on {}, {speed_kmh} km/h, {seconds} s, step {} ms, one thread",
+                v.name,
+                tr.spec().name,
+                b.dt * 1e3
+            );
+            println!(
+                "  physics only:       {:>6.2} µs per step, {:>5.1}× real time",
+                b.step_us, b.real_time_factor
+            );
+            println!(
+                "  with all channels:  {:>6.2} µs per step, {:>5.1}× real time (recording costs {:.0} % of the physics)",
+                b.step_recorded_us,
+                b.real_time_factor_recorded,
+                100.0 * (b.step_recorded_us / b.step_us - 1.0)
+            );
+            println!("  contact table (once per vehicle, all cores): {table_s:.2} s");
+            Ok(())
+        }
         What::Contact { iterations } => {
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench contact`");

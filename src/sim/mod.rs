@@ -144,6 +144,22 @@ impl<'a> Simulation<'a> {
                 cfg.duration
             )));
         }
+        // The vehicle is placed on the design geometry: its wheels must start on smooth rails
+        // (the track's smooth lead before the irregularities fade in).
+        for &w in &vehicle.contact.wheelsets {
+            let r = track.at(start + vehicle.bodies[w].position.x).rails;
+            let worst = [r.left_y, r.left_z, r.right_y, r.right_z]
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()));
+            if worst > 2e-4 {
+                return Err(Error::Domain(format!(
+                    "the vehicle would start on irregular rails ({:.1} mm at s = {:.1} m): start it on the smooth lead of track '{}' (irregularity.smooth_start_m)",
+                    worst * 1e3,
+                    start + vehicle.bodies[w].position.x,
+                    track.spec().name
+                )));
+            }
+        }
         let geo = &vehicle.contact.geometry;
         let table = vehicle.contact.table();
         // Static wheel load and its Hertz approach set the wheelsets' height.
