@@ -302,3 +302,17 @@ fn tangent_100_kmh_class_5_runs_without_derailment() {
     }
     assert!(peak_yq < 0.8, "peak |Y/Q| {peak_yq}");
 }
+
+/// Wickens' critical speed of a restrained wheelset within 5 %.
+#[test]
+#[ignore = "long simulation: run in release"]
+fn restrained_wheelset_wickens_critical_speed() {
+    let w = Vehicle::load(&root().join("vehicles/restrained_wheelset.toml")).unwrap();
+    let k = checks::wickens(&w).unwrap();
+    assert!(
+        (k.measured / k.expected - 1.0).abs() < 0.05,
+        "{} m/s vs {} m/s",
+        k.measured,
+        k.expected
+    );
+}

@@ -26,8 +26,9 @@ enum What {
         reference_dir: PathBuf,
     },
     /// The simulator's physics checks (spec §6): static wheel loads, quasi-static curving
-    /// forces on R 400 m at 60 km/h and R 800 m at 100 km/h, and Klingel's wavelength of a
-    /// free wheelset. Prints measured against expected; exits non-zero on a miss.
+    /// forces on R 400 m at 60 km/h and R 800 m at 100 km/h, Klingel's wavelength of a free
+    /// wheelset and Wickens' critical speed of a restrained one. Prints measured against
+    /// expected; exits non-zero on a miss.
     Dynamics {
         /// Vehicle for the static and curving checks.
         #[arg(long, default_value = "vehicles/c80.toml")]
@@ -35,17 +36,28 @@ enum What {
         /// Single free wheelset for the Klingel check.
         #[arg(long, default_value = "vehicles/single_wheelset.toml")]
         wheelset: PathBuf,
+        /// Single wheelset with lateral and yaw springs for the Wickens check.
+        #[arg(long, default_value = "vehicles/restrained_wheelset.toml")]
+        restrained: PathBuf,
     },
 }
 
 pub fn run(args: ValidateArgs) -> Result<()> {
     match args.what {
         What::Contact { reference_dir } => contact(&reference_dir),
-        What::Dynamics { vehicle, wheelset } => dynamics(&vehicle, &wheelset),
+        What::Dynamics {
+            vehicle,
+            wheelset,
+            restrained,
+        } => dynamics(&vehicle, &wheelset, &restrained),
     }
 }
 
-fn dynamics(vehicle: &std::path::Path, wheelset: &std::path::Path) -> Result<()> {
+fn dynamics(
+    vehicle: &std::path::Path,
+    wheelset: &std::path::Path,
+    restrained: &std::path::Path,
+) -> Result<()> {
     use railforce::sim::checks;
     let v = railforce::vehicle::Vehicle::load(vehicle)?;
     let mut misses = 0;
@@ -125,6 +137,18 @@ fn dynamics(vehicle: &std::path::Path, wheelset: &std::path::Path) -> Result<()>
         k.expected,
         dev * 100.0,
         verdict(dev < 0.01)
+    );
+    let r = railforce::vehicle::Vehicle::load(restrained)?;
+    let wk = checks::wickens(&r)?;
+    let dev = (wk.measured / wk.expected - 1.0).abs();
+    println!("Wickens, restrained wheelset ({}):", r.name);
+    println!(
+        "  critical speed {:.2} m/s (bisection on perturbation growth) vs {:.2} m/s from the formula with λe {:.4} ({:.1} %, within 5 %)  {}",
+        wk.measured,
+        wk.expected,
+        wk.conicity,
+        dev * 100.0,
+        verdict(dev < 0.05)
     );
     if misses > 0 {
         bail!("{misses} check(s) missed");

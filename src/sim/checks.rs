@@ -228,3 +228,81 @@ pub fn klingel(
         expected,
     })
 }
+
+/// Wickens: critical speed of a single wheelset restrained by lateral and yaw springs.
+#[derive(Debug, Clone)]
+pub struct WickensCheck {
+    /// Critical speed found by simulation (bisection on growth or decay of a perturbation), m/s.
+    pub measured: f64,
+    /// `sqrt((r0·b0/λe)·(k_ψ + b0²·k_y)/(m·b0² + I_z))`, m/s.
+    pub expected: f64,
+    /// Equivalent conicity used, at the perturbation's amplitude.
+    pub conicity: f64,
+}
+
+/// Whether a lateral perturbation of `amplitude` grows over `seconds` at `speed`.
+fn grows(vehicle: &Vehicle, speed: f64, amplitude: f64, seconds: f64) -> Result<bool> {
+    let track = smooth_tangent(speed * seconds + 60.0);
+    let cfg = SimConfig {
+        speed,
+        duration: seconds,
+        settle: 0.0,
+        start: Some(10.0),
+        initial_offset: amplitude,
+        ..SimConfig::default()
+    };
+    let mut sim = Simulation::new(vehicle, &track, cfg)?;
+    let steps = (seconds / sim.config().dt) as usize;
+    let (mut first, mut last) = (0.0f64, 0.0f64);
+    for i in 0..steps {
+        if sim.step().is_err() {
+            // Ran off the cones or diverged: the perturbation grew.
+            return Ok(true);
+        }
+        let y = sim.wheels[0].y_centre.abs();
+        if i < steps / 3 {
+            first = first.max(y);
+        } else if i >= 2 * steps / 3 {
+            last = last.max(y);
+        }
+    }
+    Ok(last > first)
+}
+
+/// Finds the critical speed of a restrained single wheelset (`vehicle` with one wheelset and a
+/// `track_spring`) by bisection between half and twice Wickens' value, and compares.
+pub fn wickens(vehicle: &Vehicle) -> Result<WickensCheck> {
+    let (ky, kpsi) = vehicle
+        .elements
+        .iter()
+        .find_map(|e| match e {
+            crate::vehicle::Element::TrackSpring(t) => Some((t.lateral_stiffness, t.yaw_stiffness)),
+            _ => None,
+        })
+        .ok_or_else(|| crate::Error::Domain("the Wickens check needs a track_spring".into()))?;
+    let ws = &vehicle.bodies[vehicle.contact.wheelsets[0]];
+    let table = vehicle.contact.table();
+    let centred = table.lookup(0.0);
+    let b0 = 0.5 * (centred.wheels[0].point[1] - centred.wheels[1].point[1]);
+    let r0 = 0.5 * (centred.wheels[0].rolling_radius + centred.wheels[1].rolling_radius);
+    let amplitude = 1e-3;
+    let conicity = table.equivalent_conicity(amplitude).ok_or_else(|| {
+        crate::Error::Domain("no kinematic oscillation in the contact table".into())
+    })?;
+    let expected =
+        ((r0 * b0 / conicity) * (kpsi + b0 * b0 * ky) / (ws.mass * b0 * b0 + ws.inertia.z)).sqrt();
+    let (mut lo, mut hi) = (0.5 * expected, 2.0 * expected);
+    for _ in 0..10 {
+        let mid = 0.5 * (lo + hi);
+        if grows(vehicle, mid, amplitude, 8.0)? {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(WickensCheck {
+        measured: 0.5 * (lo + hi),
+        expected,
+        conicity,
+    })
+}

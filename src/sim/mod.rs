@@ -198,6 +198,13 @@ impl<'a> Simulation<'a> {
         let n = vehicle.bodies.len();
         let frames = body_s.iter().map(|&s| TrackFrame::at(track, s)).collect();
         let mut every_step = vehicle.contact.wheelsets.clone();
+        for e in &vehicle.elements {
+            if let Element::TrackSpring(ts) = e
+                && !every_step.contains(&ts.body)
+            {
+                every_step.push(ts.body);
+            }
+        }
         if let Some(h) = vehicle.hauling {
             every_step.push(h.body);
         }
@@ -286,6 +293,12 @@ impl<'a> Simulation<'a> {
         for k in 0..self.every_step.len() {
             let i = self.every_step[k];
             self.refresh_frame(i);
+        }
+        for e in &self.vehicle.elements {
+            if let Element::TrackSpring(ts) = e {
+                let f = &self.frames[ts.body];
+                ts.apply(&self.states, &f.origin, &f.axes, &mut self.wrenches);
+            }
         }
         self.contact()?;
         self.haul();

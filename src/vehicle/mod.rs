@@ -33,6 +33,8 @@ struct VehicleFile {
     side_bearer: Vec<SideBearerFile>,
     #[serde(default)]
     cross_bracing: Vec<CrossBracingFile>,
+    #[serde(default)]
+    track_spring: Vec<TrackSpringFile>,
     hauling: Option<HaulingFile>,
     sensors: Option<SensorsFile>,
 }
@@ -132,6 +134,14 @@ struct CrossBracingFile {
     left: String,
     right: String,
     warp_stiffness: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrackSpringFile {
+    link: String,
+    lateral_stiffness: f64,
+    yaw_stiffness: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -426,6 +436,19 @@ impl Vehicle {
                 left: find(format!("{f}.left"), &e.left)?,
                 right: find(format!("{f}.right"), &e.right)?,
                 warp_stiffness: e.warp_stiffness,
+            }));
+        }
+
+        for (i, e) in raw.track_spring.iter().enumerate() {
+            let f = format!("track_spring[{i}]");
+            non_negative(
+                format!("{f}.lateral_stiffness"),
+                &[e.lateral_stiffness, e.yaw_stiffness],
+            )?;
+            elements.push(Element::TrackSpring(elements::TrackSpring {
+                body: find(format!("{f}.link"), &e.link)?,
+                lateral_stiffness: e.lateral_stiffness,
+                yaw_stiffness: e.yaw_stiffness,
             }));
         }
 

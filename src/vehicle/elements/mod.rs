@@ -9,6 +9,7 @@ mod cross_bracing;
 mod shear_pad;
 mod side_bearer;
 mod spring_nest;
+mod track_spring;
 mod wedge_damper;
 
 pub use centre_plate::CentrePlate;
@@ -16,6 +17,7 @@ pub use cross_bracing::CrossBracing;
 pub use shear_pad::ShearPad;
 pub use side_bearer::SideBearer;
 pub use spring_nest::{NestLaw, SpringNest};
+pub use track_spring::TrackSpring;
 pub use wedge_damper::WedgeDamper;
 
 use super::body::{Attachment, BodyState, Wrench};
@@ -36,6 +38,8 @@ pub enum Element {
     SideBearer(SideBearer),
     /// Cross-bracing between the two side frames of a bogie.
     CrossBracing(CrossBracing),
+    /// Lateral and yaw spring to the track (Wickens' restrained wheelset).
+    TrackSpring(TrackSpring),
 }
 
 impl Element {
@@ -49,6 +53,8 @@ impl Element {
             Element::CentrePlate(e) => e.apply(states, wrenches),
             Element::SideBearer(e) => e.apply(states, wrenches),
             Element::CrossBracing(e) => e.apply(states, wrenches),
+            // Needs the track frame: applied by the simulation (see `Simulation::step`).
+            Element::TrackSpring(_) => {}
         }
     }
 
@@ -61,6 +67,7 @@ impl Element {
             Element::CentrePlate(_) => "centre_plate",
             Element::SideBearer(_) => "side_bearer",
             Element::CrossBracing(_) => "cross_bracing",
+            Element::TrackSpring(_) => "track_spring",
         }
     }
 }

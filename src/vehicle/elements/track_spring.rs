@@ -1,0 +1,38 @@
+//! Spring from a body to the track: lateral and yaw restraint relative to the local track
+//! frame, as used by Wickens' single restrained wheelset (a wheelset held by springs to a
+//! frame that runs exactly along the track). Not part of a real wagon.
+
+use crate::vehicle::body::{BodyState, Wrench};
+use nalgebra::Matrix3;
+
+/// Lateral and yaw spring between a body and the track frame at its position.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackSpring {
+    /// Body index.
+    pub body: usize,
+    /// Lateral stiffness, N/m.
+    pub lateral_stiffness: f64,
+    /// Yaw stiffness, N·m/rad.
+    pub yaw_stiffness: f64,
+}
+
+impl TrackSpring {
+    /// Adds the restoring force and torque; `origin` and `axes` are the track frame at the
+    /// body.
+    pub(crate) fn apply(
+        &self,
+        states: &[BodyState],
+        origin: &nalgebra::Vector3<f64>,
+        axes: &Matrix3<f64>,
+        wrenches: &mut [Wrench],
+    ) {
+        let st = &states[self.body];
+        let rel = axes.transpose() * (st.position - origin);
+        let axle = axes.transpose() * st.matrix().column(1);
+        let yaw = (-axle.x).atan2(axle.y);
+        let lateral = axes.column(1).into_owned();
+        let up = axes.column(2).into_owned();
+        wrenches[self.body].force -= lateral * (self.lateral_stiffness * rel.y);
+        wrenches[self.body].torque -= up * (self.yaw_stiffness * yaw);
+    }
+}
