@@ -1,8 +1,6 @@
 //! Speed of one wheel's contact evaluation during a simulation step.
 
-use crate::contact::{
-    CreepLaw, Material, Side, WheelsetGeometry, WheelsetMotion, profile, wheel_force,
-};
+use crate::contact::{CreepLaw, Material, Side, WheelsetGeometry, WheelsetMotion, wheel_force};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -19,18 +17,8 @@ pub struct ContactBench {
     pub table_build_s: f64,
 }
 
-/// Runs the benchmark with the default C80 pair (S1002 on 60 kg/m at 1:40).
-pub fn run(iterations: usize) -> ContactBench {
-    let geo = WheelsetGeometry::new(
-        profile::s1002(),
-        profile::rail_60kg(),
-        (1.0f64 / 40.0).atan(),
-        1.435,
-        1.353,
-        0.070,
-        0.42,
-    )
-    .expect("default profiles mount");
+/// Runs the benchmark on a wheelset geometry (the vehicle file's), at 122.6 kN and 60 km/h.
+pub fn run(geo: &WheelsetGeometry, iterations: usize) -> ContactBench {
     let t = Instant::now();
     let table = geo.table(15e-3, 1e-4);
     let table_build_s = t.elapsed().as_secs_f64();
@@ -39,7 +27,7 @@ pub fn run(iterations: usize) -> ContactBench {
         lateral_velocity: 0.05,
         yaw_rate: 0.01,
         yaw: 1e-3,
-        ..WheelsetMotion::rolling(16.7, 0.42)
+        ..WheelsetMotion::rolling(16.7, geo.nominal_radius)
     };
     let time_wheel = |law: CreepLaw, n: usize| {
         let t = Instant::now();

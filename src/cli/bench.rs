@@ -15,6 +15,9 @@ enum What {
     /// creepages + Polach), against FASTSIM and a full rigid solve measured in the same run.
     /// Build with --release for meaningful numbers.
     Contact {
+        /// Vehicle file whose wheel–rail pair is timed.
+        #[arg(long, default_value = "vehicles/c80.toml")]
+        vehicle: std::path::PathBuf,
         /// Evaluations timed.
         #[arg(long, default_value_t = 2_000_000)]
         iterations: usize,
@@ -74,12 +77,21 @@ pub fn run(args: BenchArgs) -> Result<()> {
             println!("  contact table (once per vehicle, all cores): {table_s:.2} s");
             Ok(())
         }
-        What::Contact { iterations } => {
+        What::Contact {
+            vehicle,
+            iterations,
+        } => {
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench contact`");
             }
-            let b = railforce::bench::contact::run(iterations);
-            println!("contact benchmark (one thread, S1002 on 60 kg/m at 1:40, 122.6 kN, 60 km/h)");
+            let v = railforce::vehicle::Vehicle::load(&vehicle)?;
+            let b = railforce::bench::contact::run(&v.contact.geometry, iterations);
+            println!(
+                "contact benchmark ({}: {} on {}, one thread, 122.6 kN, 60 km/h)",
+                v.name,
+                v.contact.geometry.wheel().name,
+                v.contact.geometry.rail().name
+            );
             println!(
                 "  one wheel, table + Hertz + Polach: {:>10.1} ns  ({:.2}× the 1 µs budget)",
                 b.wheel_polach_ns,

@@ -302,18 +302,23 @@ impl Vehicle {
             }
         };
 
+        // Upper and lower attachments of a two-point element at the shared point `at`.
+        let pair =
+            |f: &str, upper: &str, lower: &str, at: [f64; 3]| -> Result<(Attachment, Attachment)> {
+                let u = find(format!("{f}.upper"), upper)?;
+                let l = find(format!("{f}.lower"), lower)?;
+                Ok((attach(f, u, at)?, attach(f, l, at)?))
+            };
+
         let mut elements = Vec::new();
         for (i, e) in raw.shear_pad.iter().enumerate() {
             let f = format!("shear_pad[{i}]");
             non_negative(format!("{f}.stiffness"), &e.stiffness)?;
             non_negative(format!("{f}.damping"), &e.damping)?;
-            let (u, l) = (
-                find(format!("{f}.upper"), &e.upper)?,
-                find(format!("{f}.lower"), &e.lower)?,
-            );
+            let (upper, lower) = pair(&f, &e.upper, &e.lower, e.at)?;
             elements.push(Element::ShearPad(ShearPad {
-                upper: attach(&f, u, e.at)?,
-                lower: attach(&f, l, e.at)?,
+                upper,
+                lower,
                 stiffness: Vector3::from(e.stiffness),
                 damping: Vector3::from(e.damping),
                 preload: 0.0,
@@ -327,13 +332,10 @@ impl Vehicle {
             positive(format!("{f}.vertical_stiffness"), e.vertical_stiffness[1])?;
             non_negative(format!("{f}.lateral_stiffness"), &[e.lateral_stiffness])?;
             positive(format!("{f}.first_stage_travel_m"), e.first_stage_travel_m)?;
-            let (u, l) = (
-                find(format!("{f}.upper"), &e.upper)?,
-                find(format!("{f}.lower"), &e.lower)?,
-            );
+            let (upper, lower) = pair(&f, &e.upper, &e.lower, e.at)?;
             let nest = SpringNest {
-                upper: attach(&f, u, e.at)?,
-                lower: attach(&f, l, e.at)?,
+                upper,
+                lower,
                 law: NestLaw {
                     k1: e.vertical_stiffness[0],
                     k2: e.vertical_stiffness[1],
@@ -357,14 +359,11 @@ impl Vehicle {
                 format!("{f}.regularisation_velocity"),
                 e.regularisation_velocity,
             )?;
-            let (u, l) = (
-                find(format!("{f}.upper"), &e.upper)?,
-                find(format!("{f}.lower"), &e.lower)?,
-            );
+            let (upper, lower) = pair(&f, &e.upper, &e.lower, e.at)?;
             // The nest between the same bodies presses this wedge.
             let nest = nests
                 .iter()
-                .find(|&&k| matches!(&elements[k], Element::SpringNest(n) if n.upper.body == u && n.lower.body == l))
+                .find(|&&k| matches!(&elements[k], Element::SpringNest(n) if n.upper.body == upper.body && n.lower.body == lower.body))
                 .copied()
                 .ok_or_else(|| {
                     cfg(
@@ -374,8 +373,8 @@ impl Vehicle {
                 })?;
             wedges.push((elements.len(), nest));
             elements.push(Element::WedgeDamper(WedgeDamper {
-                upper: attach(&f, u, e.at)?,
-                lower: attach(&f, l, e.at)?,
+                upper,
+                lower,
                 friction_ratio: e.friction_ratio,
                 regularisation_velocity: e.regularisation_velocity,
                 nest: match &elements[nest] {
@@ -391,13 +390,10 @@ impl Vehicle {
             non_negative(format!("{f}.friction"), &[e.friction])?;
             positive(format!("{f}.radius_m"), e.radius_m)?;
             positive(format!("{f}.regularisation_rate"), e.regularisation_rate)?;
-            let (u, l) = (
-                find(format!("{f}.upper"), &e.upper)?,
-                find(format!("{f}.lower"), &e.lower)?,
-            );
+            let (upper, lower) = pair(&f, &e.upper, &e.lower, e.at)?;
             elements.push(Element::CentrePlate(CentrePlate {
-                upper: attach(&f, u, e.at)?,
-                lower: attach(&f, l, e.at)?,
+                upper,
+                lower,
                 stiffness: Vector3::from(e.stiffness),
                 damping: Vector3::from(e.damping),
                 friction: e.friction,
@@ -416,13 +412,10 @@ impl Vehicle {
                 format!("{f}.regularisation_velocity"),
                 e.regularisation_velocity,
             )?;
-            let (u, l) = (
-                find(format!("{f}.upper"), &e.upper)?,
-                find(format!("{f}.lower"), &e.lower)?,
-            );
+            let (upper, lower) = pair(&f, &e.upper, &e.lower, e.at)?;
             elements.push(Element::SideBearer(SideBearer {
-                upper: attach(&f, u, e.at)?,
-                lower: attach(&f, l, e.at)?,
+                upper,
+                lower,
                 stiffness: e.stiffness,
                 preload: e.preload_n,
                 friction: e.friction,
