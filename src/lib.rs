@@ -10,6 +10,7 @@
 
 pub mod bench;
 pub mod contact;
+pub mod dataset;
 pub mod dsp;
 pub mod error;
 pub mod io;

@@ -3,6 +3,7 @@
 
 mod bench;
 mod contact;
+mod generate;
 mod simulate;
 mod track;
 mod validate;
@@ -46,6 +47,13 @@ enum Command {
     /// than 50 ms) stops with a message naming the time and the wheel or body; nothing
     /// non-finite is ever written, and the CSV appears only when complete.
     Simulate(simulate::SimulateArgs),
+    /// Generate a data set: every condition and seed of a plan, in parallel, one file per run
+    /// (npz or csv) plus manifest.json; resumable, shardable (`--shard i/N`, then `--merge`).
+    ///
+    /// A rerun skips the runs the manifest lists as done with the same definition and redoes
+    /// the rest; files are written atomically. `--snr-db X` adds `<channel>_noisy` copies of
+    /// the 21 input channels (white Gaussian noise at X dB, seeded); labels are never noised.
+    Generate(generate::GenerateArgs),
     /// Check railforce against reference solutions (`validate contact`).
     Validate(validate::ValidateArgs),
     /// Built-in benchmarks with same-run references (`bench contact`).
@@ -59,6 +67,7 @@ pub fn main() -> ExitCode {
         Command::Track(args) => track::run(args),
         Command::Contact(args) => contact::run(args),
         Command::Simulate(args) => simulate::run(args),
+        Command::Generate(args) => generate::run(args),
         Command::Validate(args) => validate::run(args),
         Command::Bench(args) => bench::run(args),
     };

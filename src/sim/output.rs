@@ -11,6 +11,7 @@ use super::filter::Lowpass;
 use super::{Simulation, wheel_name};
 use crate::error::{Error, Result};
 use nalgebra::Vector3;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Names of the paper's 21 input channels, in order X1 … X21 (spec §5).
@@ -265,15 +266,46 @@ pub struct RunSummary {
     pub out: PathBuf,
 }
 
-/// Runs a simulation: settles, records `duration` seconds, streams the rows into a CSV file
-/// (temporary file, renamed when complete) and writes `<out>.meta.json` beside it. `progress`
-/// receives the fraction done.
-pub fn run_to_csv(
-    sim: &mut Simulation,
-    out: &Path,
-    meta: &serde_json::Value,
-    mut progress: impl FnMut(f64),
-) -> Result<RunSummary> {
+/// A recorded run held in memory: channel names and units, and rows of values.
+#[derive(Debug, Clone)]
+pub struct Recording {
+    /// Channel names.
+    pub names: Vec<String>,
+    /// Units.
+    pub units: Vec<&'static str>,
+    /// Rows at the output rate.
+    pub rows: Vec<Vec<f64>>,
+    /// What the run reports.
+    pub summary: RunSummary,
+}
+
+impl Recording {
+    /// One column by index.
+    pub fn column(&self, i: usize) -> Vec<f64> {
+        self.rows.iter().map(|r| r[i]).collect()
+    }
+
+    /// Writes the rows as CSV with a header line.
+    pub fn write_csv(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        writeln!(w, "{}", self.names.join(","))?;
+        for row in &self.rows {
+            let mut first = true;
+            for x in row {
+                if !first {
+                    w.write_all(b",")?;
+                }
+                first = false;
+                write!(w, "{x:.7e}")?;
+            }
+            w.write_all(b"\n")?;
+        }
+        Ok(())
+    }
+}
+
+/// Runs a simulation: settles, then records `duration` seconds in memory (about 0.3 MB per
+/// simulated second for the C80's 189 channels). `progress` receives the fraction done.
+pub fn record(sim: &mut Simulation, mut progress: impl FnMut(f64)) -> Result<Recording> {
     let t0 = std::time::Instant::now();
     sim.settle()?;
     let mut rec = Recorder::new(sim);
@@ -281,8 +313,6 @@ pub fn run_to_csv(
     let n_wheels = sim.wheels.len();
     let mut peak = vec![0.0f64; n_wheels];
     let mut sums = vec![(0.0, 0.0); n_wheels];
-    let mut steps = 0usize;
-    let mut rows = 0usize;
     let wheel_col = rec
         .names()
         .iter()
@@ -291,88 +321,84 @@ pub fn run_to_csv(
     let static_load =
         sim.vehicle().mass() * crate::GRAVITY / sim.vehicle().contact.wheelsets.len() as f64 / 2.0;
     let total_steps = (duration / sim.config().dt).round() as usize;
-    let mut result: Result<()> = Ok(());
-    crate::io::write_atomic(out, |w| {
-        writeln!(w, "{}", rec.names().join(","))?;
-        while steps <= total_steps {
-            if steps > 0
-                && let Err(e) = sim.step()
-            {
-                result = Err(e);
-                return Err(std::io::Error::other("simulation stopped"));
-            }
-            for (k, wr) in sim.wheels.iter().enumerate() {
-                sums[k].0 += wr.y;
-                sums[k].1 += wr.q;
-            }
-            if let Some(row) = rec.sample(&mut *sim) {
-                // Y/Q from the recorded (filtered) forces, where the wheel carries at least
-                // 10 % of its static load (Y/Q of an unloaded wheel means nothing).
-                for (k, p) in peak.iter_mut().enumerate() {
-                    let (y, q) = (row[wheel_col + 7 * k], row[wheel_col + 7 * k + 1]);
-                    if q > 0.1 * static_load {
-                        *p = p.max((y / q).abs());
-                    }
-                }
-                if row.iter().any(|x| !x.is_finite()) {
-                    result = Err(Error::Domain(format!(
-                        "non-finite signal at t = {:.4} s: nothing is written",
-                        sim.time()
-                    )));
-                    return Err(std::io::Error::other("non-finite"));
-                }
-                let mut first = true;
-                for x in row {
-                    if !first {
-                        w.write_all(b",")?;
-                    }
-                    first = false;
-                    write!(w, "{x:.7e}")?;
-                }
-                w.write_all(b"\n")?;
-                rows += 1;
-            }
-            steps += 1;
-            if steps.is_multiple_of(2000) {
-                progress(steps as f64 / total_steps.max(1) as f64);
-            }
+    let mut rows = Vec::with_capacity((duration * sim.config().output_rate) as usize + 1);
+    for steps in 0..=total_steps {
+        if steps > 0 {
+            sim.step()?;
         }
-        Ok(())
-    })
-    .or_else(|e| match (&result, e) {
-        (Err(_), _) => Ok(()),
-        (Ok(()), e) => Err(e),
-    })?;
-    result?;
+        for (k, wr) in sim.wheels.iter().enumerate() {
+            sums[k].0 += wr.y;
+            sums[k].1 += wr.q;
+        }
+        if let Some(row) = rec.sample(&mut *sim) {
+            if row.iter().any(|x| !x.is_finite()) {
+                return Err(Error::Domain(format!(
+                    "non-finite signal at t = {:.4} s: nothing is written",
+                    sim.time()
+                )));
+            }
+            // Y/Q from the recorded (filtered) forces, where the wheel carries at least 10 %
+            // of its static load (Y/Q of an unloaded wheel means nothing).
+            for (k, p) in peak.iter_mut().enumerate() {
+                let (y, q) = (row[wheel_col + 7 * k], row[wheel_col + 7 * k + 1]);
+                if q > 0.1 * static_load {
+                    *p = p.max((y / q).abs());
+                }
+            }
+            rows.push(row.to_vec());
+        }
+        if steps % 2000 == 1999 {
+            progress(steps as f64 / total_steps.max(1) as f64);
+        }
+    }
     let wall = t0.elapsed().as_secs_f64();
-    let n = (steps.max(1)) as f64;
-    let summary = RunSummary {
+    let n = (total_steps + 1) as f64;
+    Ok(Recording {
+        names: rec.names().to_vec(),
+        units: rec.units().to_vec(),
+        summary: RunSummary {
+            rows: rows.len(),
+            simulated: duration,
+            wall,
+            real_time_factor: (duration + sim.config().settle) / wall,
+            peak_y_over_q: peak,
+            mean_yq: sums.iter().map(|&(y, q)| (y / n, q / n)).collect(),
+            out: PathBuf::new(),
+        },
         rows,
-        simulated: duration,
-        wall,
-        real_time_factor: (duration + sim.config().settle) / wall,
-        peak_y_over_q: peak,
-        mean_yq: sums.iter().map(|&(y, q)| (y / n, q / n)).collect(),
-        out: out.to_path_buf(),
-    };
+    })
+}
+
+/// Runs a simulation and writes it to a CSV file (temporary file, renamed when complete) with
+/// `<out>.meta.json` beside it.
+pub fn run_to_csv(
+    sim: &mut Simulation,
+    out: &Path,
+    meta: &serde_json::Value,
+    progress: impl FnMut(f64),
+) -> Result<RunSummary> {
+    let recording = record(sim, progress)?;
+    crate::io::write_atomic(out, |w| recording.write_csv(w))?;
     let mut meta = meta.clone();
     if let Some(m) = meta.as_object_mut() {
         m.insert(
             "channels".into(),
-            rec.names()
+            recording
+                .names
                 .iter()
-                .zip(rec.units())
+                .zip(&recording.units)
                 .map(|(n, u)| serde_json::json!({"name": n, "unit": u}))
                 .collect(),
         );
-        m.insert("rows".into(), rows.into());
-        m.insert("wall_time_s".into(), wall.into());
+        m.insert("rows".into(), recording.rows.len().into());
+        m.insert("wall_time_s".into(), recording.summary.wall.into());
     }
-    let meta_path = meta_path(out);
-    crate::io::write_atomic(&meta_path, |w| {
+    crate::io::write_atomic(&meta_path(out), |w| {
         serde_json::to_writer_pretty(&mut *w, &meta).map_err(std::io::Error::other)?;
         w.write_all(b"\n")
     })?;
+    let mut summary = recording.summary;
+    summary.out = out.to_path_buf();
     Ok(summary)
 }
 

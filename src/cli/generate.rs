@@ -1,0 +1,120 @@
+//! `railforce generate`: data sets per working condition.
+
+use anyhow::{Result, bail};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use railforce::dataset::{self, Event, Format, GenerateOptions};
+use railforce::plan::Plan;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    /// Plan file (TOML): vehicle, duration, seeds and [[condition]] tables.
+    #[arg(long, required_unless_present = "merge")]
+    plan: Option<PathBuf>,
+    /// Output folder (one file per run plus manifest.json).
+    #[arg(long)]
+    out: PathBuf,
+    /// File format: csv or npz (NumPy).
+    #[arg(long, default_value = "npz")]
+    format: String,
+    /// Runs in parallel [default: the number of cores].
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Only this shard of the plan, `i/N` (1-based), for batch schedulers: runs k with
+    /// k mod N = i − 1; writes manifest.shard-i-of-N.json.
+    #[arg(long, value_name = "i/N")]
+    shard: Option<String>,
+    /// Add noised copies of the 21 input channels at this signal-to-noise ratio, dB.
+    #[arg(long, allow_hyphen_values = true)]
+    snr_db: Option<f64>,
+    /// Settling time of each run, s (not written).
+    #[arg(long, default_value_t = 3.0)]
+    settle: f64,
+    /// Join the shard manifests in --out into manifest.json instead of generating.
+    #[arg(long)]
+    merge: bool,
+}
+
+pub fn run(args: GenerateArgs) -> Result<()> {
+    if args.merge {
+        let m = dataset::merge(&args.out)?;
+        println!(
+            "merged {} shard manifests: {} runs in {}",
+            m["merged_from"].as_array().map(|a| a.len()).unwrap_or(0),
+            m["runs"].as_array().map(|a| a.len()).unwrap_or(0),
+            args.out.join("manifest.json").display()
+        );
+        return Ok(());
+    }
+    let plan_path = args.plan.expect("clap requires --plan without --merge");
+    let plan = Plan::load(&plan_path)?;
+    let format = Format::parse(&args.format)
+        .ok_or_else(|| anyhow::anyhow!("--format must be csv or npz, got {}", args.format))?;
+    let shard = match &args.shard {
+        None => None,
+        Some(s) => {
+            let parsed = s
+                .split_once('/')
+                .and_then(|(i, n)| i.parse::<usize>().ok().zip(n.parse::<usize>().ok()));
+            match parsed {
+                Some((i, n)) if n >= 1 && (1..=n).contains(&i) => Some((i, n)),
+                _ => bail!("--shard must be i/N with 1 ≤ i ≤ N, got {s}"),
+            }
+        }
+    };
+    let jobs = args.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|p| p.get())
+            .unwrap_or(1)
+    });
+    let opts = GenerateOptions {
+        out: args.out.clone(),
+        format,
+        jobs,
+        shard,
+        snr_db: args.snr_db,
+        settle: args.settle,
+    };
+    let total = dataset::runs(&plan)
+        .iter()
+        .filter(|r| shard.is_none_or(|(i, n)| r.index % n == i - 1))
+        .count();
+    let bar = ProgressBar::new(total as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} runs, eta {eta} {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_prefix(format!("generating {}", plan.name));
+    let t0 = std::time::Instant::now();
+    let running = std::sync::Mutex::new(Vec::<String>::new());
+    let on_event = |e: Event| {
+        let mut r = running.lock().expect("lock");
+        match e {
+            Event::Started(f) => r.push(f),
+            Event::Skipped(f) => {
+                bar.println(format!("skip {f} (done)"));
+                bar.inc(1);
+            }
+            Event::Finished(f, wall) => {
+                r.retain(|x| *x != f);
+                bar.println(format!("done {f} in {wall:.1} s"));
+                bar.inc(1);
+            }
+        }
+        bar.set_message(r.join(" "));
+    };
+    let result = dataset::generate(&plan, &opts, &on_event);
+    bar.finish_and_clear();
+    let manifest = result?;
+    println!(
+        "{} runs in {} ({} format) in {:.1} s with {jobs} jobs; manifest: {}",
+        manifest["runs"].as_array().map(|a| a.len()).unwrap_or(0),
+        args.out.display(),
+        format.ext(),
+        t0.elapsed().as_secs_f64(),
+        dataset::manifest_path(&opts).display()
+    );
+    Ok(())
+}

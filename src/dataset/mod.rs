@@ -1,0 +1,465 @@
+//! Data sets per working condition: runs every (condition, seed) of a plan, in parallel,
+//! writes one file per run (CSV or NPZ) and a `manifest.json` that describes every channel and
+//! run. Interruption loses nothing: files are written atomically, the manifest after every
+//! finished run, and a rerun skips the runs the manifest lists as done with an unchanged
+//! definition. `--shard i/N` splits a plan across machines; `merge` joins shard manifests.
+
+pub mod npz;
+
+use crate::error::{Error, Result};
+use crate::plan::{Condition, Plan};
+use crate::sim::output::{self, PAPER_CHANNELS, Recording};
+use crate::sim::{SimConfig, Simulation};
+use crate::track::{Track, TrackSpec};
+use crate::vehicle::Vehicle;
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// File format of the runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Comma-separated values with a header row.
+    Csv,
+    /// NumPy `.npz`: one float64 array per channel.
+    Npz,
+}
+
+impl Format {
+    /// Parses `csv` or `npz`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "csv" => Some(Format::Csv),
+            "npz" => Some(Format::Npz),
+            _ => None,
+        }
+    }
+
+    /// File extension.
+    pub fn ext(self) -> &'static str {
+        match self {
+            Format::Csv => "csv",
+            Format::Npz => "npz",
+        }
+    }
+}
+
+/// How to generate.
+#[derive(Debug, Clone)]
+pub struct GenerateOptions {
+    /// Output folder.
+    pub out: PathBuf,
+    /// File format.
+    pub format: Format,
+    /// Runs in parallel.
+    pub jobs: usize,
+    /// This shard `(i, n)`, 1-based: runs with index `k` where `k % n == i − 1`.
+    pub shard: Option<(usize, usize)>,
+    /// Add noised copies of the input channels at this signal-to-noise ratio, dB.
+    pub snr_db: Option<f64>,
+    /// Settling time of each run, s.
+    pub settle: f64,
+}
+
+/// One run of a plan.
+#[derive(Debug, Clone)]
+pub struct RunSpec {
+    /// Position in the plan's list of runs.
+    pub index: usize,
+    /// Its condition.
+    pub condition: Condition,
+    /// Irregularity seed.
+    pub seed: u64,
+}
+
+impl RunSpec {
+    /// Output file name.
+    pub fn file_name(&self, format: Format) -> String {
+        format!("{}_seed{}.{}", self.condition.name, self.seed, format.ext())
+    }
+}
+
+/// Every (condition, seed) pair of a plan, in plan order.
+pub fn runs(plan: &Plan) -> Vec<RunSpec> {
+    let mut out = Vec::new();
+    for c in &plan.conditions {
+        for &seed in &c.seeds {
+            out.push(RunSpec {
+                index: out.len(),
+                condition: c.clone(),
+                seed,
+            });
+        }
+    }
+    out
+}
+
+/// FNV-1a 64 of bytes, hex.
+pub fn fnv1a(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+fn file_hash(path: &Path) -> Result<String> {
+    Ok(fnv1a(&std::fs::read(path).map_err(|e| Error::io(path, e))?))
+}
+
+/// Noise per input channel (spec learning.md §1.4): white Gaussian, `σ_c = rms_c·10^(−SNR/20)`
+/// with `rms_c` the RMS of the clean channel over the run; seeded by the run's seed and the
+/// channel's position, so the same run gives the same noise.
+pub fn noise_column(clean: &[f64], snr_db: f64, seed: u64, channel: usize) -> Vec<f64> {
+    let rms = (clean.iter().map(|x| x * x).sum::<f64>() / clean.len().max(1) as f64).sqrt();
+    let sigma = rms * 10f64.powf(-snr_db / 20.0);
+    let mut rng =
+        ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ channel as u64);
+    match Normal::new(0.0, sigma) {
+        Ok(n) if sigma > 0.0 => clean.iter().map(|x| x + n.sample(&mut rng)).collect(),
+        _ => clean.to_vec(),
+    }
+}
+
+/// What kind of channel a name is, for the manifest.
+fn channel_kind(name: &str) -> (&'static str, Option<String>) {
+    if name == "time_s" || name == "s_m" {
+        return ("axis", None);
+    }
+    if let Some(base) = name.strip_suffix("_noisy")
+        && PAPER_CHANNELS.contains(&base)
+    {
+        return ("input_noisy", None);
+    }
+    if PAPER_CHANNELS.contains(&name) {
+        return ("input", None);
+    }
+    if name == "w1l_force_y" || name == "w1l_force_z" {
+        return ("label", Some("1L".into()));
+    }
+    if let Some(rest) = name.strip_prefix('w')
+        && rest.len() > 3
+        && rest.as_bytes()[0].is_ascii_digit()
+        && rest.as_bytes()[2] == b'_'
+    {
+        return ("wheel", Some(rest[..2].to_ascii_uppercase()));
+    }
+    ("body", None)
+}
+
+/// Definition of a run for resuming: changes whenever anything that shapes its data changes.
+fn run_key(run: &RunSpec, opts: &GenerateOptions, track_hash: &str, vehicle_hash: &str) -> String {
+    fnv1a(
+        format!(
+            "{}|{}|{}|{}|{}|{}|{:?}|{}|{}|{}",
+            run.condition.name,
+            track_hash,
+            vehicle_hash,
+            run.condition.speed_kmh,
+            run.condition.duration,
+            run.seed,
+            opts.snr_db,
+            opts.format.ext(),
+            opts.settle,
+            env!("CARGO_PKG_VERSION")
+        )
+        .as_bytes(),
+    )
+}
+
+/// Manifest file of this generation (`manifest.json`, or `manifest.shard-i-of-n.json`).
+pub fn manifest_path(opts: &GenerateOptions) -> PathBuf {
+    match opts.shard {
+        None => opts.out.join("manifest.json"),
+        Some((i, n)) => opts.out.join(format!("manifest.shard-{i}-of-{n}.json")),
+    }
+}
+
+fn write_manifest(path: &Path, manifest: &Value) -> Result<()> {
+    crate::io::write_atomic(path, |w| {
+        serde_json::to_writer_pretty(&mut *w, manifest).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    })
+}
+
+fn read_manifest(path: &Path) -> Result<Option<Value>> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = crate::io::read_text(path)?;
+    serde_json::from_str(&text)
+        .map(Some)
+        .map_err(|e| Error::Parse {
+            file: path.to_path_buf(),
+            message: e.to_string(),
+        })
+}
+
+/// Progress events of a generation.
+#[derive(Debug, Clone)]
+pub enum Event {
+    /// A run started.
+    Started(String),
+    /// A run was skipped: already done.
+    Skipped(String),
+    /// A run finished, with its wall time.
+    Finished(String, f64),
+}
+
+/// Generates the data set of a plan (or of one shard of it). Returns the manifest.
+pub fn generate(
+    plan: &Plan,
+    opts: &GenerateOptions,
+    events: &(dyn Fn(Event) + Sync),
+) -> Result<Value> {
+    if let Some((i, n)) = opts.shard
+        && !(n >= 1 && (1..=n).contains(&i))
+    {
+        return Err(Error::Domain(format!(
+            "--shard must be i/N with 1 ≤ i ≤ N, got {i}/{n}"
+        )));
+    }
+    if let Some(snr) = opts.snr_db
+        && !snr.is_finite()
+    {
+        return Err(Error::Domain(format!("--snr-db must be finite, got {snr}")));
+    }
+    std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
+    let vehicle = Vehicle::load(&plan.vehicle)?;
+    let vehicle_hash = file_hash(&plan.vehicle)?;
+    // Check every track before any run (a bad file should fail now, not after an hour).
+    let mine: Vec<RunSpec> = runs(plan)
+        .into_iter()
+        .filter(|r| opts.shard.is_none_or(|(i, n)| r.index % n == i - 1))
+        .collect();
+    let mut tracks = Vec::new();
+    for r in &mine {
+        let spec = TrackSpec::load(&r.condition.track)?;
+        tracks.push((spec, file_hash(&r.condition.track)?));
+    }
+    let manifest_file = manifest_path(opts);
+    let previous = read_manifest(&manifest_file)?;
+    let done: Vec<Value> = previous
+        .as_ref()
+        .and_then(|m| m.get("runs").and_then(|r| r.as_array()).cloned())
+        .unwrap_or_default();
+    vehicle.contact.table(); // build once, before the threads
+    let manifest = Mutex::new(json!({
+        "tool": format!("railforce {}", env!("CARGO_PKG_VERSION")),
+        "plan": plan.source,
+        "plan_name": plan.name,
+        "vehicle": {"file": plan.vehicle, "hash_fnv1a": vehicle_hash, "name": vehicle.name},
+        "format": opts.format.ext(),
+        "sampling_rate_hz": SimConfig::default().output_rate,
+        "snr_db": opts.snr_db,
+        "noise": "input channels only (suffix _noisy): white Gaussian, sigma = rms(clean) * 10^(-SNR/20), seeded per run and channel; clean channels always kept; labels never noised",
+        "shard": opts.shard.map(|(i, n)| format!("{i}/{n}")),
+        "conventions": {
+            "frame": "track frame: x along the running direction, y to the left, z up",
+            "forces": "forces of the rail on the wheel in the track frame: force_y = Y (+ left), force_z = Q (+ up) (EN: Y lateral, Q vertical; Chinese standards: Q lateral, P vertical)",
+            "wheels": "1L..4R numbered from the front, left/right facing the running direction",
+            "accelerations": "accelerometer reading (specific force a - g, +9.81 m/s2 vertically at rest), body axes; wheelsets in the local track axes",
+            "labels": {"FL": "w1l_force_y", "FQ": "w1l_force_z"},
+        },
+        "channels": Value::Null,
+        "runs": [],
+    }));
+    let next = AtomicUsize::new(0);
+    let first_error: Mutex<Option<Error>> = Mutex::new(None);
+    let work = |k: usize| -> Result<()> {
+        let run = &mine[k];
+        let (spec, track_hash) = &tracks[k];
+        let key = run_key(run, opts, track_hash, &vehicle_hash);
+        let file = run.file_name(opts.format);
+        let path = opts.out.join(&file);
+        if let Some(entry) = done.iter().find(|e| e["key"] == key.as_str())
+            && path.exists()
+        {
+            events(Event::Skipped(file.clone()));
+            let mut m = manifest.lock().expect("manifest lock");
+            if m["channels"].is_null() {
+                m["channels"] = previous
+                    .as_ref()
+                    .map(|p| p["channels"].clone())
+                    .unwrap_or(Value::Null);
+            }
+            m["runs"].as_array_mut().expect("runs").push(entry.clone());
+            return Ok(());
+        }
+        events(Event::Started(file.clone()));
+        let track = Track::new(spec.clone(), Some(run.seed));
+        let cfg = SimConfig {
+            speed: run.condition.speed(),
+            duration: run.condition.duration,
+            settle: opts.settle,
+            ..SimConfig::default()
+        };
+        let mut sim = Simulation::new(&vehicle, &track, cfg)
+            .map_err(|e| Error::Domain(format!("{}: {e}", run.condition.name)))?;
+        let mut rec = output::record(&mut sim, |_| {}).map_err(|e| {
+            Error::Domain(format!("{} (seed {}): {e}", run.condition.name, run.seed))
+        })?;
+        if let Some(snr) = opts.snr_db {
+            add_noise(&mut rec, snr, run.seed);
+        }
+        write_run(&path, &rec, opts.format)?;
+        let bytes_hash = file_hash(&path)?;
+        let entry = json!({
+            "key": key,
+            "condition": run.condition.name,
+            "seed": run.seed,
+            "file": file,
+            "bytes_hash_fnv1a": bytes_hash,
+            "track": {"file": run.condition.track, "hash_fnv1a": track_hash, "name": spec.name},
+            "speed_kmh": run.condition.speed_kmh,
+            "duration_s": run.condition.duration,
+            "rows": rec.rows.len(),
+            "wall_time_s": rec.summary.wall,
+            "peak_y_over_q": rec.summary.peak_y_over_q,
+        });
+        let mut m = manifest.lock().expect("manifest lock");
+        if m["channels"].is_null() {
+            m["channels"] = rec
+                .names
+                .iter()
+                .zip(&rec.units)
+                .map(|(n, u)| {
+                    let (kind, wheel) = channel_kind(n);
+                    json!({"name": n, "unit": u, "kind": kind, "wheel": wheel})
+                })
+                .collect();
+        }
+        m["runs"].as_array_mut().expect("runs").push(entry);
+        sort_runs(&mut m);
+        write_manifest(&manifest_file, &m)?;
+        events(Event::Finished(file, rec.summary.wall));
+        Ok(())
+    };
+    std::thread::scope(|scope| {
+        for _ in 0..opts.jobs.max(1).min(mine.len().max(1)) {
+            scope.spawn(|| {
+                loop {
+                    if first_error.lock().expect("error lock").is_some() {
+                        return;
+                    }
+                    let k = next.fetch_add(1, Ordering::SeqCst);
+                    if k >= mine.len() {
+                        return;
+                    }
+                    if let Err(e) = work(k) {
+                        first_error.lock().expect("error lock").get_or_insert(e);
+                        return;
+                    }
+                }
+            });
+        }
+    });
+    let mut m = manifest.into_inner().expect("manifest lock");
+    sort_runs(&mut m);
+    write_manifest(&manifest_file, &m)?;
+    if let Some(e) = first_error.into_inner().expect("error lock") {
+        return Err(e);
+    }
+    Ok(m)
+}
+
+fn sort_runs(m: &mut Value) {
+    if let Some(runs) = m["runs"].as_array_mut() {
+        runs.sort_by(|a, b| {
+            (a["condition"].as_str(), a["seed"].as_u64())
+                .cmp(&(b["condition"].as_str(), b["seed"].as_u64()))
+        });
+    }
+}
+
+/// Appends `<name>_noisy` copies of the paper's input channels.
+fn add_noise(rec: &mut Recording, snr_db: f64, seed: u64) {
+    let inputs: Vec<(usize, String)> = rec
+        .names
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| PAPER_CHANNELS.contains(&n.as_str()))
+        .map(|(i, n)| (i, n.clone()))
+        .collect();
+    for (c, (i, name)) in inputs.into_iter().enumerate() {
+        let noisy = noise_column(&rec.column(i), snr_db, seed, c);
+        rec.names.push(format!("{name}_noisy"));
+        rec.units.push(rec.units[i]);
+        for (row, v) in rec.rows.iter_mut().zip(noisy) {
+            row.push(v);
+        }
+    }
+}
+
+/// Writes a recording in a format, atomically.
+pub fn write_run(path: &Path, rec: &Recording, format: Format) -> Result<()> {
+    match format {
+        Format::Csv => crate::io::write_atomic(path, |w| rec.write_csv(w)),
+        Format::Npz => {
+            let cols: Vec<Vec<f64>> = (0..rec.names.len()).map(|i| rec.column(i)).collect();
+            let named: Vec<(&str, &[f64])> = rec
+                .names
+                .iter()
+                .map(|n| n.as_str())
+                .zip(cols.iter().map(|c| c.as_slice()))
+                .collect();
+            crate::io::write_atomic(path, |w| npz::write_npz(w, &named))
+        }
+    }
+}
+
+/// Joins the shard manifests in `out` into `manifest.json` (runs sorted by condition and seed).
+pub fn merge(out: &Path) -> Result<Value> {
+    let mut shards: Vec<PathBuf> = std::fs::read_dir(out)
+        .map_err(|e| Error::io(out, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .map(|n| n.to_string_lossy().starts_with("manifest.shard-"))
+                .unwrap_or(false)
+        })
+        .collect();
+    shards.sort();
+    if shards.is_empty() {
+        return Err(Error::Domain(format!(
+            "no manifest.shard-*.json in {}",
+            out.display()
+        )));
+    }
+    let mut merged: Option<Value> = None;
+    for path in &shards {
+        let m = read_manifest(path)?.expect("listed file exists");
+        match merged.as_mut() {
+            None => merged = Some(m),
+            Some(all) => {
+                for key in ["vehicle", "format", "snr_db", "plan"] {
+                    if all[key] != m[key] {
+                        return Err(Error::Domain(format!(
+                            "{} disagrees with the other shards on '{key}'",
+                            path.display()
+                        )));
+                    }
+                }
+                if all["channels"].is_null() {
+                    all["channels"] = m["channels"].clone();
+                }
+                let runs = m["runs"].as_array().cloned().unwrap_or_default();
+                all["runs"].as_array_mut().expect("runs").extend(runs);
+            }
+        }
+    }
+    let mut m = merged.expect("at least one shard");
+    m["shard"] = Value::Null;
+    m["merged_from"] = shards
+        .iter()
+        .map(|p| Value::from(p.file_name().unwrap().to_string_lossy().into_owned()))
+        .collect();
+    sort_runs(&mut m);
+    write_manifest(&out.join("manifest.json"), &m)?;
+    Ok(m)
+}
