@@ -161,29 +161,44 @@ fn generate_resume_shard_merge_and_formats() {
         }
     }
 
-    // Python users load the NPZ in one line.
-    python_loads(&file, channels.len());
+    // Parquet of the same run holds exactly the same numbers.
+    let d = dir.join("d");
+    run_events(&plan, &opts(&d, Format::Parquet, Some((1, 3))));
+    let pq = d.join("tangent_v80_seed1.parquet");
+    let back = dataset::parquet_file::read_parquet(std::fs::read(&pq).unwrap()).unwrap();
+    assert_eq!(back, cols);
+
+    // Python users load the NPZ and the Parquet file in one line.
+    python_loads(&file, &pq, channels.len());
 }
 
-fn python_loads(npz_file: &Path, n_channels: usize) {
+fn python_loads(npz_file: &Path, parquet_file: &Path, n_channels: usize) {
     let required = std::env::var_os("RAILFORCE_PYTHON_TESTS").is_some();
     let check = std::process::Command::new("python3")
-        .args(["-c", "import numpy"])
+        .args(["-c", "import numpy, pyarrow"])
         .output();
     if !matches!(&check, Ok(o) if o.status.success()) {
         assert!(
             !required,
-            "python3 with numpy is required (RAILFORCE_PYTHON_TESTS is set)"
+            "python3 with numpy and pyarrow is required (RAILFORCE_PYTHON_TESTS is set)"
         );
-        eprintln!("skipping the Python check: no python3 with numpy");
+        eprintln!("skipping the Python check: no python3 with numpy and pyarrow");
         return;
     }
-    let script = format!(
-        "import numpy as np\nd = np.load(r'{}')\nassert len(d.files) == {n_channels}, len(d.files)\n\
-         assert d['w1l_force_z'].shape == (61,)\nassert d['frame_l_acc_y_noisy'].dtype == np.float64\n\
-         assert 60e3 < d['w1l_force_z'].mean() < 200e3\nprint('ok')",
-        npz_file.display()
-    );
+    let script = [
+        "import numpy as np, pyarrow.parquet as pq".to_string(),
+        format!("d = np.load(r'{}')", npz_file.display()),
+        format!("assert len(d.files) == {n_channels}, len(d.files)"),
+        "assert d['w1l_force_z'].shape == (61,)".into(),
+        "assert d['frame_l_acc_y_noisy'].dtype == np.float64".into(),
+        "assert 60e3 < d['w1l_force_z'].mean() < 200e3".into(),
+        format!("t = pq.read_table(r'{}')", parquet_file.display()),
+        format!("assert t.num_rows == 61 and t.num_columns == {n_channels}"),
+        "assert t.column_names == d.files".into(),
+        "assert np.array_equal(t.column('w1l_force_z').to_numpy(), d['w1l_force_z'])".into(),
+        "print('ok')".into(),
+    ]
+    .join("\n");
     let out = std::process::Command::new("python3")
         .args(["-c", &script])
         .output()

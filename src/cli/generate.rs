@@ -15,7 +15,7 @@ pub struct GenerateArgs {
     /// Output folder (one file per run plus manifest.json).
     #[arg(long)]
     out: PathBuf,
-    /// File format: csv or npz (NumPy).
+    /// File format: npz (NumPy), parquet (pandas, polars) or csv.
     #[arg(long, default_value = "npz")]
     format: String,
     /// Runs in parallel [default: the number of cores].
@@ -49,8 +49,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     }
     let plan_path = args.plan.expect("clap requires --plan without --merge");
     let plan = Plan::load(&plan_path)?;
-    let format = Format::parse(&args.format)
-        .ok_or_else(|| anyhow::anyhow!("--format must be csv or npz, got {}", args.format))?;
+    let format = Format::parse(&args.format).ok_or_else(|| {
+        anyhow::anyhow!("--format must be npz, parquet or csv, got {}", args.format)
+    })?;
     let shard = match &args.shard {
         None => None,
         Some(s) => {

@@ -5,6 +5,7 @@
 //! definition. `--shard i/N` splits a plan across machines; `merge` joins shard manifests.
 
 pub mod npz;
+pub mod parquet_file;
 
 use crate::error::{Error, Result};
 use crate::plan::{Condition, Plan};
@@ -27,14 +28,17 @@ pub enum Format {
     Csv,
     /// NumPy `.npz`: one float64 array per channel.
     Npz,
+    /// Apache Parquet: one DOUBLE column per channel (pandas, polars, pyarrow).
+    Parquet,
 }
 
 impl Format {
-    /// Parses `csv` or `npz`.
+    /// Parses `csv`, `npz` or `parquet`.
     pub fn parse(s: &str) -> Option<Self> {
         match s {
             "csv" => Some(Format::Csv),
             "npz" => Some(Format::Npz),
+            "parquet" => Some(Format::Parquet),
             _ => None,
         }
     }
@@ -44,6 +48,7 @@ impl Format {
         match self {
             Format::Csv => "csv",
             Format::Npz => "npz",
+            Format::Parquet => "parquet",
         }
     }
 }
@@ -400,7 +405,7 @@ fn add_noise(rec: &mut Recording, snr_db: f64, seed: u64) {
 pub fn write_run(path: &Path, rec: &Recording, format: Format) -> Result<()> {
     match format {
         Format::Csv => crate::io::write_atomic(path, |w| rec.write_csv(w)),
-        Format::Npz => {
+        Format::Npz | Format::Parquet => {
             let cols: Vec<Vec<f64>> = (0..rec.names.len()).map(|i| rec.column(i)).collect();
             let named: Vec<(&str, &[f64])> = rec
                 .names
@@ -408,7 +413,14 @@ pub fn write_run(path: &Path, rec: &Recording, format: Format) -> Result<()> {
                 .map(|n| n.as_str())
                 .zip(cols.iter().map(|c| c.as_slice()))
                 .collect();
-            crate::io::write_atomic(path, |w| npz::write_npz(w, &named))
+            if format == Format::Npz {
+                crate::io::write_atomic(path, |w| npz::write_npz(w, &named))
+            } else {
+                let bytes = parquet_file::write_parquet(&named).map_err(|e| {
+                    Error::Domain(format!("{}: Parquet encoding failed: {e}", path.display()))
+                })?;
+                crate::io::write_atomic(path, |w| w.write_all(&bytes))
+            }
         }
     }
 }

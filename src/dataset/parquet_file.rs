@@ -1,0 +1,97 @@
+//! Parquet writer: one required DOUBLE column per channel, one row group, no compression (the
+//! crate's codecs stay out of the build); pandas, polars and pyarrow read it directly
+//! (`pd.read_parquet("run.parquet")`).
+
+use parquet::basic::{Repetition, Type as PhysicalType};
+use parquet::data_type::DoubleType;
+use parquet::errors::ParquetError;
+use parquet::file::properties::WriterProperties;
+use parquet::file::reader::{FileReader, SerializedFileReader};
+use parquet::file::writer::SerializedFileWriter;
+use parquet::schema::types::Type;
+use std::sync::Arc;
+
+/// Encodes named columns as a Parquet file in memory.
+pub fn write_parquet(columns: &[(&str, &[f64])]) -> Result<Vec<u8>, ParquetError> {
+    let fields = columns
+        .iter()
+        .map(|(name, _)| {
+            Type::primitive_type_builder(name, PhysicalType::DOUBLE)
+                .with_repetition(Repetition::REQUIRED)
+                .build()
+                .map(Arc::new)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let schema = Arc::new(
+        Type::group_type_builder("run")
+            .with_fields(fields)
+            .build()?,
+    );
+    let props = Arc::new(
+        WriterProperties::builder()
+            .set_created_by(format!("railforce {}", env!("CARGO_PKG_VERSION")))
+            .build(),
+    );
+    let mut buf = Vec::new();
+    let mut writer = SerializedFileWriter::new(&mut buf, schema, props)?;
+    let mut group = writer.next_row_group()?;
+    for (name, values) in columns {
+        let mut col = group
+            .next_column()?
+            .ok_or_else(|| ParquetError::General(format!("no column writer for {name}")))?;
+        col.typed::<DoubleType>().write_batch(values, None, None)?;
+        col.close()?;
+    }
+    group.close()?;
+    writer.close()?;
+    Ok(buf)
+}
+
+/// Reads a Parquet file written by [`write_parquet`] back into named columns.
+pub fn read_parquet(bytes: Vec<u8>) -> Result<Vec<(String, Vec<f64>)>, ParquetError> {
+    let reader = SerializedFileReader::new(bytes::Bytes::from(bytes))?;
+    let schema = reader.metadata().file_metadata().schema_descr_ptr();
+    let mut cols: Vec<(String, Vec<f64>)> = schema
+        .columns()
+        .iter()
+        .map(|c| (c.name().to_string(), Vec::new()))
+        .collect();
+    for row in reader.get_row_iter(None)? {
+        let row = row?;
+        for (k, (_, field)) in row.get_column_iter().enumerate() {
+            match field {
+                parquet::record::Field::Double(v) => cols[k].1.push(*v),
+                other => {
+                    return Err(ParquetError::General(format!(
+                        "column {} is not DOUBLE: {other:?}",
+                        cols[k].0
+                    )));
+                }
+            }
+        }
+    }
+    Ok(cols)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parquet_round_trip() {
+        let a = [1.0, -2.5, 1e300];
+        let b = [0.0, 0.1, 0.2];
+        let bytes = write_parquet(&[("a", &a), ("b_x", &b)]).unwrap();
+        assert_eq!(&bytes[..4], b"PAR1");
+        let back = read_parquet(bytes.clone()).unwrap();
+        assert_eq!(
+            back,
+            vec![
+                ("a".to_string(), a.to_vec()),
+                ("b_x".to_string(), b.to_vec())
+            ]
+        );
+        // Deterministic bytes.
+        assert_eq!(bytes, write_parquet(&[("a", &a), ("b_x", &b)]).unwrap());
+    }
+}
