@@ -13,6 +13,7 @@ pub mod contact;
 pub mod dataset;
 pub mod dsp;
 pub mod error;
+pub mod features;
 pub mod io;
 pub mod plan;
 pub mod sim;

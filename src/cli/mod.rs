@@ -4,6 +4,7 @@
 mod bench;
 mod contact;
 mod generate;
+mod select;
 mod simulate;
 mod track;
 mod validate;
@@ -54,6 +55,13 @@ enum Command {
     /// the rest; files are written atomically. `--snr-db X` adds `<channel>_noisy` copies of
     /// the 21 input channels (white Gaussian noise at X dB, seeded); labels are never noised.
     Generate(generate::GenerateArgs),
+    /// Feature selection on a data set: mutual information of each of the 21 inputs with the
+    /// target (Kraskov k = 3), then forward selection by validation R² of ridge regression on
+    /// flattened windows; writes the selected channels and their z-score statistics.
+    ///
+    /// The split is leak-free: each run is cut into contiguous 70/15/15 % blocks before
+    /// windowing, and all statistics come from the training blocks.
+    Select(select::SelectArgs),
     /// Check railforce against reference solutions (`validate contact`).
     Validate(validate::ValidateArgs),
     /// Built-in benchmarks with same-run references (`bench contact`).
@@ -68,6 +76,7 @@ pub fn main() -> ExitCode {
         Command::Contact(args) => contact::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Generate(args) => generate::run(args),
+        Command::Select(args) => select::run(args),
         Command::Validate(args) => validate::run(args),
         Command::Bench(args) => bench::run(args),
     };

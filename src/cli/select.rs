@@ -1,0 +1,86 @@
+//! `railforce select`: mutual-information filter, then wrapper, on a data set.
+
+use anyhow::Result;
+use clap::Args;
+use railforce::features::{self, DataSet, LabelAt, SelectOptions, Split};
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct SelectArgs {
+    /// Data set folder (written by `railforce generate`).
+    #[arg(long)]
+    data: PathBuf,
+    /// Target: FL (lateral force on wheel 1L), FQ (vertical) or a channel name.
+    #[arg(long, default_value = "FQ")]
+    target: String,
+    /// Drop channels whose mutual information with the target is below this, nats.
+    #[arg(long, default_value_t = 0.01)]
+    mi_threshold: f64,
+    /// Stop the wrapper when the best validation-R² gain is below this.
+    #[arg(long, default_value_t = 0.002)]
+    tolerance: f64,
+    /// Select among the `_noisy` input copies (the data set must have them: generate --snr-db).
+    #[arg(long)]
+    noisy: bool,
+    /// Window length, steps.
+    #[arg(long, default_value_t = 20)]
+    window: usize,
+    /// Label at the centre step of the window (non-causal) instead of the last.
+    #[arg(long)]
+    centre_label: bool,
+    /// Where to write the selection (channels and z-score statistics).
+    #[arg(long, default_value = "selection.json")]
+    out: PathBuf,
+}
+
+pub fn run(args: SelectArgs) -> Result<()> {
+    let t0 = std::time::Instant::now();
+    let ds = DataSet::load(&args.data)?;
+    let opts = SelectOptions {
+        target: args.target.clone(),
+        noisy: args.noisy,
+        mi_threshold: args.mi_threshold,
+        tolerance: args.tolerance,
+        window: args.window,
+        label_at: if args.centre_label {
+            LabelAt::Centre
+        } else {
+            LabelAt::Last
+        },
+        ..SelectOptions::default()
+    };
+    let sel = features::select(&ds, &Split::default(), &opts)?;
+    println!(
+        "target {} ({}), {} runs, split 70/15/15 per run, window {}:",
+        args.target,
+        sel.target,
+        ds.runs.len(),
+        sel.window
+    );
+    println!(
+        "  {:<22} {:>8} {:>13} {:>5}",
+        "channel", "MI nats", "wrapper gain", "kept"
+    );
+    for r in &sel.table {
+        println!(
+            "  {:<22} {:>8.4} {:>13} {:>5}",
+            r.channel,
+            r.mi,
+            r.wrapper_gain
+                .map(|g| format!("{g:+.4}"))
+                .unwrap_or_else(|| "filtered".into()),
+            if r.kept { "yes" } else { "" }
+        );
+    }
+    railforce::io::write_atomic(&args.out, |w| {
+        serde_json::to_writer_pretty(&mut *w, &sel).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    })?;
+    println!(
+        "kept {} of 21 channels; wrote {} in {:.1} s",
+        sel.channels.len(),
+        args.out.display(),
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

@@ -1,0 +1,398 @@
+//! Leak-free samples (spec learning.md §1): split first, window second. Each run is cut into
+//! contiguous blocks (default 70/15/15 % train/validation/test), or whole conditions are held
+//! out; windows of `window` steps never cross a block boundary; windows are indices into the
+//! runs, not copies. Z-score statistics come from the training rows only.
+
+use crate::dataset::{npz, parquet_file};
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// One run of a data set: its columns in the data set's channel order.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// Condition name.
+    pub condition: String,
+    /// Seed.
+    pub seed: u64,
+    /// Columns (same order as [`DataSet::names`]).
+    pub columns: Vec<Vec<f64>>,
+}
+
+impl Run {
+    /// Number of time steps.
+    pub fn len(&self) -> usize {
+        self.columns.first().map(|c| c.len()).unwrap_or(0)
+    }
+
+    /// Whether the run has no rows.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// A data set written by `railforce generate`, read through its manifest.
+#[derive(Debug, Clone)]
+pub struct DataSet {
+    /// Folder.
+    pub dir: PathBuf,
+    /// Channel names.
+    pub names: Vec<String>,
+    /// Runs in manifest order.
+    pub runs: Vec<Run>,
+}
+
+impl DataSet {
+    /// Reads `manifest.json` and every run file it lists (npz, parquet or csv).
+    pub fn load(dir: &Path) -> Result<Self> {
+        let mpath = dir.join("manifest.json");
+        let text = crate::io::read_text(&mpath)?;
+        let m: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::Parse {
+            file: mpath.clone(),
+            message: e.to_string(),
+        })?;
+        let runs_meta = m["runs"].as_array().cloned().unwrap_or_default();
+        if runs_meta.is_empty() {
+            return Err(Error::config(&mpath, "runs", "the manifest lists no runs"));
+        }
+        let mut names: Option<Vec<String>> = None;
+        let mut runs = Vec::new();
+        for r in runs_meta {
+            let file = dir.join(r["file"].as_str().unwrap_or_default());
+            let bytes = std::fs::read(&file).map_err(|e| Error::io(&file, e))?;
+            let ext = file.extension().map(|e| e.to_string_lossy().into_owned());
+            let cols: Vec<(String, Vec<f64>)> = match ext.as_deref() {
+                Some("npz") => npz::read_npz(&bytes).map_err(|e| Error::io(&file, e))?,
+                Some("parquet") => parquet_file::read_parquet(bytes).map_err(|e| Error::Parse {
+                    file: file.clone(),
+                    message: e.to_string(),
+                })?,
+                _ => read_csv(&bytes, &file)?,
+            };
+            let these: Vec<String> = cols.iter().map(|(n, _)| n.clone()).collect();
+            match &names {
+                None => names = Some(these),
+                Some(n) if *n != these => {
+                    return Err(Error::Parse {
+                        file,
+                        message: "its channels differ from the first run's".into(),
+                    });
+                }
+                _ => {}
+            }
+            runs.push(Run {
+                condition: r["condition"].as_str().unwrap_or_default().to_string(),
+                seed: r["seed"].as_u64().unwrap_or(0),
+                columns: cols.into_iter().map(|(_, v)| v).collect(),
+            });
+        }
+        Ok(DataSet {
+            dir: dir.to_path_buf(),
+            names: names.unwrap_or_default(),
+            runs,
+        })
+    }
+
+    /// Index of a channel, or an error naming it and the data set.
+    pub fn channel(&self, name: &str) -> Result<usize> {
+        self.names.iter().position(|n| n == name).ok_or_else(|| {
+            Error::Domain(format!(
+                "unknown channel '{name}' in {} (it has {} channels, e.g. {})",
+                self.dir.display(),
+                self.names.len(),
+                self.names
+                    .iter()
+                    .take(5)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })
+    }
+}
+
+fn read_csv(bytes: &[u8], file: &Path) -> Result<Vec<(String, Vec<f64>)>> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap_or_default()
+        .split(',')
+        .map(|s| s.to_string())
+        .collect();
+    let mut cols = vec![Vec::new(); header.len()];
+    for (ln, line) in lines.enumerate() {
+        for (k, v) in line.split(',').enumerate() {
+            let x: f64 = v.parse().map_err(|_| Error::Parse {
+                file: file.to_path_buf(),
+                message: format!("row {}, column {}: not a number", ln + 2, k + 1),
+            })?;
+            cols.get_mut(k)
+                .ok_or_else(|| Error::Parse {
+                    file: file.to_path_buf(),
+                    message: format!("row {} has more fields than the header", ln + 2),
+                })?
+                .push(x);
+        }
+    }
+    Ok(header.into_iter().zip(cols).collect())
+}
+
+/// Where the label of a window sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LabelAt {
+    /// The last step (causal: usable on board in real time).
+    Last,
+    /// The centre step (non-causal, as the paper reads).
+    Centre,
+}
+
+/// How runs are split.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Split {
+    /// Contiguous blocks of every run: the first `train`, then `val`, the rest test.
+    Blocks {
+        /// Training fraction.
+        train: f64,
+        /// Validation fraction.
+        val: f64,
+    },
+    /// Whole conditions held out for validation and test; all others train.
+    Conditions {
+        /// Validation conditions.
+        val: Vec<String>,
+        /// Test conditions.
+        test: Vec<String>,
+    },
+}
+
+impl Default for Split {
+    fn default() -> Self {
+        Split::Blocks {
+            train: 0.70,
+            val: 0.15,
+        }
+    }
+}
+
+/// A window: steps `start .. start + window` of run `run`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Window {
+    /// Run index.
+    pub run: u32,
+    /// First step.
+    pub start: u32,
+}
+
+/// A block of rows `[from, to)` of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Block {
+    /// Run index.
+    pub run: usize,
+    /// First row.
+    pub from: usize,
+    /// One past the last row.
+    pub to: usize,
+}
+
+/// Windows of the three parts, and the blocks they come from.
+#[derive(Debug, Clone)]
+pub struct Samples {
+    /// Steps per window.
+    pub window: usize,
+    /// Label position.
+    pub label_at: LabelAt,
+    /// Training blocks.
+    pub train_blocks: Vec<Block>,
+    /// Validation blocks.
+    pub val_blocks: Vec<Block>,
+    /// Test blocks.
+    pub test_blocks: Vec<Block>,
+    /// Windows per part.
+    pub train: Vec<Window>,
+    /// See `train`.
+    pub val: Vec<Window>,
+    /// See `train`.
+    pub test: Vec<Window>,
+}
+
+impl Samples {
+    /// Splits and windows a data set.
+    pub fn build(
+        ds: &DataSet,
+        split: &Split,
+        window: usize,
+        stride: usize,
+        label_at: LabelAt,
+    ) -> Result<Self> {
+        if window == 0 || stride == 0 {
+            return Err(Error::Domain("window and stride must be at least 1".into()));
+        }
+        let (mut tr, mut va, mut te) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, run) in ds.runs.iter().enumerate() {
+            let n = run.len();
+            match split {
+                Split::Blocks { train, val } => {
+                    if !(*train > 0.0 && *val >= 0.0 && train + val < 1.0) {
+                        return Err(Error::Domain(format!(
+                            "block fractions must satisfy 0 < train, 0 ≤ val, train + val < 1 (got {train}, {val})"
+                        )));
+                    }
+                    let a = (n as f64 * train).round() as usize;
+                    let b = (n as f64 * (train + val)).round() as usize;
+                    tr.push(Block {
+                        run: i,
+                        from: 0,
+                        to: a,
+                    });
+                    va.push(Block {
+                        run: i,
+                        from: a,
+                        to: b,
+                    });
+                    te.push(Block {
+                        run: i,
+                        from: b,
+                        to: n,
+                    });
+                }
+                Split::Conditions { val, test } => {
+                    let block = Block {
+                        run: i,
+                        from: 0,
+                        to: n,
+                    };
+                    if test.contains(&run.condition) {
+                        te.push(block);
+                    } else if val.contains(&run.condition) {
+                        va.push(block);
+                    } else {
+                        tr.push(block);
+                    }
+                }
+            }
+        }
+        let windows = |blocks: &[Block], stride: usize| -> Vec<Window> {
+            let mut out = Vec::new();
+            for b in blocks {
+                let mut s = b.from;
+                while s + window <= b.to {
+                    out.push(Window {
+                        run: b.run as u32,
+                        start: s as u32,
+                    });
+                    s += stride;
+                }
+            }
+            out
+        };
+        Ok(Samples {
+            window,
+            label_at,
+            train: windows(&tr, stride),
+            val: windows(&va, 1),
+            test: windows(&te, 1),
+            train_blocks: tr,
+            val_blocks: va,
+            test_blocks: te,
+        })
+    }
+
+    /// Row of a window's label.
+    pub fn label_row(&self, w: &Window) -> usize {
+        w.start as usize
+            + match self.label_at {
+                LabelAt::Last => self.window - 1,
+                LabelAt::Centre => self.window / 2,
+            }
+    }
+}
+
+/// Mean and standard deviation per channel, from the training blocks only.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ZScore {
+    /// Channel names.
+    pub names: Vec<String>,
+    /// Means.
+    pub mean: Vec<f64>,
+    /// Standard deviations (1 where a channel is constant).
+    pub std: Vec<f64>,
+}
+
+impl ZScore {
+    /// Statistics of `channels` over the training blocks.
+    pub fn fit(ds: &DataSet, blocks: &[Block], channels: &[usize]) -> Self {
+        let mut mean = vec![0.0; channels.len()];
+        let mut sq = vec![0.0; channels.len()];
+        let mut n = 0usize;
+        for b in blocks {
+            for r in b.from..b.to {
+                for (k, &c) in channels.iter().enumerate() {
+                    let v = ds.runs[b.run].columns[c][r];
+                    mean[k] += v;
+                    sq[k] += v * v;
+                }
+                n += 1;
+            }
+        }
+        let n = n.max(1) as f64;
+        let mean: Vec<f64> = mean.iter().map(|m| m / n).collect();
+        let std = sq
+            .iter()
+            .zip(&mean)
+            .map(|(s, m)| {
+                let v = (s / n - m * m).max(0.0).sqrt();
+                if v > 0.0 { v } else { 1.0 }
+            })
+            .collect();
+        ZScore {
+            names: channels.iter().map(|&c| ds.names[c].clone()).collect(),
+            mean,
+            std,
+        }
+    }
+
+    /// Standardised value of channel `k` (position in this statistic).
+    #[inline]
+    pub fn apply(&self, k: usize, v: f64) -> f64 {
+        (v - self.mean[k]) / self.std[k]
+    }
+}
+
+/// Which inputs each part reads when the data set has `_noisy` copies (spec learning.md §1.4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum NoiseProtocol {
+    /// Train and validate on clean inputs, test on noisy ones.
+    TrainCleanTestNoisy,
+    /// Every part reads the noisy inputs (train and test at the same SNR).
+    Matched,
+    /// No noise anywhere.
+    Clean,
+}
+
+/// A part of the samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// Training windows.
+    Train,
+    /// Validation windows.
+    Val,
+    /// Test windows.
+    Test,
+}
+
+impl NoiseProtocol {
+    /// The column a part reads for the input `channel`.
+    pub fn column(self, channel: &str, part: Part) -> String {
+        let noisy = match self {
+            NoiseProtocol::Clean => false,
+            NoiseProtocol::Matched => true,
+            NoiseProtocol::TrainCleanTestNoisy => part == Part::Test,
+        };
+        if noisy {
+            format!("{channel}_noisy")
+        } else {
+            channel.to_string()
+        }
+    }
+}
