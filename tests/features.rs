@@ -83,6 +83,18 @@ fn windows_never_cross_a_block_boundary() {
     .unwrap();
     assert!(h.test.iter().all(|w| w.run == 2) && h.val.iter().all(|w| w.run == 1));
     assert!(h.train.iter().all(|w| w.run == 0));
+    let r = features::Samples::build(
+        &ds,
+        &Split::Runs {
+            val: vec![0],
+            test: vec![1],
+        },
+        20,
+        1,
+        LabelAt::Last,
+    )
+    .unwrap();
+    assert!(r.test.iter().all(|w| w.run == 1) && r.train.iter().all(|w| w.run == 2));
 }
 
 #[test]

@@ -157,6 +157,13 @@ pub enum Split {
         /// Validation fraction.
         val: f64,
     },
+    /// Whole runs (by position in the data set) held out for validation and test.
+    Runs {
+        /// Validation runs.
+        val: Vec<usize>,
+        /// Test runs.
+        test: Vec<usize>,
+    },
     /// Whole conditions held out for validation and test; all others train.
     Conditions {
         /// Validation conditions.
