@@ -263,6 +263,20 @@ impl Samples {
                         to: n,
                     });
                 }
+                Split::Runs { val, test } => {
+                    let block = Block {
+                        run: i,
+                        from: 0,
+                        to: n,
+                    };
+                    if test.contains(&i) {
+                        te.push(block);
+                    } else if val.contains(&i) {
+                        va.push(block);
+                    } else {
+                        tr.push(block);
+                    }
+                }
                 Split::Conditions { val, test } => {
                     let block = Block {
                         run: i,
