@@ -40,14 +40,9 @@ pub struct SimulateArgs {
 }
 
 /// FNV-1a hash of a file's bytes, as hex: identifies the inputs of a run.
-pub fn file_hash(path: &std::path::Path) -> Result<String> {
+fn file_hash(path: &std::path::Path) -> Result<String> {
     let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    Ok(format!("{h:016x}"))
+    Ok(railforce::dataset::fnv1a(&bytes))
 }
 
 pub fn run(args: SimulateArgs) -> Result<()> {
