@@ -40,6 +40,17 @@ fn c80_has_eleven_bodies_of_100_t_and_its_elements() {
         .sum();
     let above_wheelsets = (100_000.0 - 4.0 * 1300.0) * railforce::GRAVITY;
     assert!((pads / above_wheelsets - 1.0).abs() < 1e-12);
+    // What the URDF says arrives unchanged: joint origins place the bodies, inertials give
+    // mass and principal moments.
+    let ws1 = &v.bodies[v.body_index("wheelset1").unwrap()];
+    assert_eq!(ws1.position, nalgebra::Vector3::new(5.015, 0.0, 0.42));
+    assert_eq!(ws1.mass, 1300.0);
+    let b1 = &v.bodies[v.body_index("bolster1").unwrap()];
+    assert_eq!(b1.inertia, nalgebra::Vector3::new(200.0, 50.0, 200.0));
+    let sf = &v.bodies[v.body_index("sideframe2r").unwrap()];
+    assert_eq!(sf.position, nalgebra::Vector3::new(-4.1, -0.978, 0.45));
+    assert_eq!(v.contact.wheelsets.len(), 4);
+    assert!(v.sensors.is_some() && v.hauling.is_some());
 }
 
 #[test]
