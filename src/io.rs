@@ -48,6 +48,20 @@ pub fn read_text(path: &Path) -> Result<String> {
     fs::read_to_string(path).map_err(|e| Error::io(path, e))
 }
 
+/// Parses TOML text into `T`; the error names the file and carries the parser's message (key,
+/// line and column), as every configuration error does.
+pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str, path: &Path) -> Result<T> {
+    toml::from_str(text).map_err(|e| Error::Parse {
+        file: path.to_path_buf(),
+        message: e.to_string().trim_end().to_string(),
+    })
+}
+
+/// Reads and parses a TOML file into `T` (see [`parse_toml`]).
+pub fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    parse_toml(&read_text(path)?, path)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -72,11 +72,7 @@ impl Plan {
     /// Reads and validates a plan file (the track files themselves are checked by
     /// [`crate::track::TrackSpec::load`] when used).
     pub fn load(path: &Path) -> Result<Self> {
-        let text = crate::io::read_text(path)?;
-        let raw: PlanFile = toml::from_str(&text).map_err(|e| Error::Parse {
-            file: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
+        let raw: PlanFile = crate::io::read_toml(path)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let positive = |field: String, v: f64| {
             if v.is_finite() && v > 0.0 {

@@ -1,6 +1,6 @@
 //! `railforce simulate`: one run of a vehicle on a track.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use railforce::sim::{SimConfig, Simulation, output, wheel_name};
@@ -39,12 +39,6 @@ pub struct SimulateArgs {
     keep_going: bool,
 }
 
-/// FNV-1a hash of a file's bytes, as hex: identifies the inputs of a run.
-fn file_hash(path: &std::path::Path) -> Result<String> {
-    let bytes = std::fs::read(path).with_context(|| path.display().to_string())?;
-    Ok(railforce::dataset::fnv1a(&bytes))
-}
-
 pub fn run(args: SimulateArgs) -> Result<()> {
     if !(args.duration > 0.0 && args.duration.is_finite()) {
         bail!("--duration must be positive, got {}", args.duration);
@@ -68,8 +62,8 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     let mut sim = Simulation::new(&vehicle, &track, cfg)?;
     let meta = serde_json::json!({
         "tool": format!("railforce {}", env!("CARGO_PKG_VERSION")),
-        "vehicle": {"file": args.vehicle, "hash_fnv1a": file_hash(&args.vehicle)?, "name": vehicle.name},
-        "track": {"file": args.track, "hash_fnv1a": file_hash(&args.track)?, "name": track.spec().name},
+        "vehicle": {"file": args.vehicle, "hash_fnv1a": railforce::dataset::file_hash(&args.vehicle)?, "name": vehicle.name},
+        "track": {"file": args.track, "hash_fnv1a": railforce::dataset::file_hash(&args.track)?, "name": track.spec().name},
         "seed": track.irregularities().map(|i| i.spec().seed),
         "speed_kmh": args.speed_kmh,
         "duration_s": args.duration,

@@ -113,7 +113,8 @@ pub fn fnv1a(bytes: &[u8]) -> String {
     format!("{h:016x}")
 }
 
-fn file_hash(path: &Path) -> Result<String> {
+/// FNV-1a 64 of a file's bytes, hex: identifies the inputs of a run.
+pub fn file_hash(path: &Path) -> Result<String> {
     Ok(fnv1a(&std::fs::read(path).map_err(|e| Error::io(path, e))?))
 }
 

@@ -129,10 +129,7 @@ impl TrackSpec {
 
     /// Parses and validates track TOML text; `path` is only used in messages.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let raw: TrackFile = toml::from_str(text).map_err(|e| Error::Parse {
-            file: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
+        let raw: TrackFile = crate::io::parse_toml(text, path)?;
         let err = |field: String, msg: String| Error::config(path, field, msg);
 
         check_range(path, "rail_spacing_m", raw.rail_spacing_m, 0.5, 3.0)?;

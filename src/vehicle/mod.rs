@@ -254,11 +254,7 @@ impl Vehicle {
     /// Reads a vehicle TOML file and the URDF it names, validates everything and computes the
     /// static preloads of the supporting elements from the load path.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = crate::io::read_text(path)?;
-        let raw: VehicleFile = toml::from_str(&text).map_err(|e| Error::Parse {
-            file: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
+        let raw: VehicleFile = crate::io::read_toml(path)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let urdf_path = dir.join(&raw.urdf);
         let bodies = read_urdf(&urdf_path)?;
