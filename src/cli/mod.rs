@@ -49,7 +49,7 @@ enum Command {
     /// non-finite is ever written, and the CSV appears only when complete.
     Simulate(simulate::SimulateArgs),
     /// Generate a data set: every condition and seed of a plan, in parallel, one file per run
-    /// (npz or csv) plus manifest.json; resumable, shardable (`--shard i/N`, then `--merge`).
+    /// (npz, parquet or csv) plus manifest.json; resumable, shardable (`--shard i/N`, then `--merge`).
     ///
     /// A rerun skips the runs the manifest lists as done with the same definition and redoes
     /// the rest; files are written atomically. `--snr-db X` adds `<channel>_noisy` copies of
@@ -62,9 +62,9 @@ enum Command {
     /// The split is leak-free: each run is cut into contiguous 70/15/15 % blocks before
     /// windowing, and all statistics come from the training blocks.
     Select(select::SelectArgs),
-    /// Check railforce against reference solutions (`validate contact`).
+    /// Check railforce against reference solutions (`validate contact`, `validate dynamics`).
     Validate(validate::ValidateArgs),
-    /// Built-in benchmarks with same-run references (`bench contact`).
+    /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`).
     Bench(bench::BenchArgs),
 }
 
