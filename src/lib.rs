@@ -15,6 +15,7 @@ pub mod dsp;
 pub mod error;
 pub mod features;
 pub mod io;
+pub mod learn;
 pub mod plan;
 pub mod sim;
 pub mod track;

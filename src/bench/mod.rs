@@ -2,4 +2,5 @@
 //! same run, and reports the ratio, so figures compare across machines.
 
 pub mod contact;
+pub mod learn;
 pub mod simulate;

@@ -7,6 +7,7 @@ mod generate;
 mod select;
 mod simulate;
 mod track;
+mod train;
 mod validate;
 
 use clap::{Parser, Subcommand};
@@ -62,6 +63,17 @@ enum Command {
     /// The split is leak-free: each run is cut into contiguous 70/15/15 % blocks before
     /// windowing, and all statistics come from the training blocks.
     Select(select::SelectArgs),
+    /// Train a model (cnn-bilstm, cnn, bilstm, gru, svr, gbdt, xgboost, tree) on a data set.
+    ///
+    /// Leak-free windows (70/15/15 % contiguous blocks per run, or whole conditions held out),
+    /// z-scores from the training blocks only. Networks: Adam, MSE, batch 64, early stopping
+    /// on the validation loss (patience 20) with the best weights restored, a checkpoint every
+    /// epoch (`--resume`), train_log.jsonl. Classical models: fitted on up to 40 000 training
+    /// windows. The model directory holds everything `evaluate` and `identify` need.
+    Train(train::TrainArgs),
+    /// Score a trained model on a data set: MSE and R² on standardised targets with
+    /// Var(y_test), RMSE and MAE in kN, predictions to CSV.
+    Evaluate(train::EvaluateArgs),
     /// Check railforce against reference solutions (`validate contact`, `validate dynamics`).
     Validate(validate::ValidateArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`).
@@ -77,6 +89,8 @@ pub fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Select(args) => select::run(args),
+        Command::Train(args) => train::run(args),
+        Command::Evaluate(args) => train::run_evaluate(args),
         Command::Validate(args) => validate::run(args),
         Command::Bench(args) => bench::run(args),
     };

@@ -148,7 +148,8 @@ pub enum LabelAt {
 }
 
 /// How runs are split.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Split {
     /// Contiguous blocks of every run: the first `train`, then `val`, the rest test.
     Blocks {

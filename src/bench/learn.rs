@@ -1,0 +1,103 @@
+//! Training and inference throughput of the networks (windows per second, one thread), with
+//! the spec's PyTorch reference figures (learning.md §5) and this machine's sustained GEMM rate
+//! measured in the same run (the hardware reference the ratio is read against).
+
+use crate::learn::linalg::gemm;
+use crate::learn::neural::{Adam, Architecture, NetConfig, Network};
+use std::time::Instant;
+
+/// One architecture's figures.
+#[derive(Debug, Clone)]
+pub struct NetBench {
+    /// Network.
+    pub architecture: Architecture,
+    /// Training windows per second (forward + backward + Adam) at the batch size.
+    pub train_windows_per_s: f64,
+    /// Inference windows per second in batches of 1024.
+    pub infer_windows_per_s: f64,
+    /// Inference latency of one window, ms.
+    pub single_ms: f64,
+    /// PyTorch 2.15 CPU one-thread training reference (spec §5), windows/s.
+    pub pytorch_train_reference: f64,
+}
+
+/// Spec §5 reference training rates (batch 64).
+pub fn pytorch_reference(a: Architecture) -> f64 {
+    match a {
+        Architecture::CnnBiLstm => 7_400.0,
+        Architecture::Cnn => 10_000.0,
+        Architecture::BiLstm => 38_000.0,
+        Architecture::Gru => 37_000.0,
+    }
+}
+
+/// Sustained single-thread GEMM rate, GFLOP/s, on the LSTM input projection's shape.
+pub fn gemm_gflops() -> f64 {
+    let (m, k, n) = (64 * 19, 128, 160);
+    let a = vec![0.5f32; m * k];
+    let b = vec![0.25f32; k * n];
+    let mut c = vec![0.0f32; m * n];
+    let mut reps = 0;
+    let t0 = Instant::now();
+    while t0.elapsed().as_secs_f64() < 0.5 {
+        gemm(m, k, n, &a, false, &b, false, &mut c, 0.0);
+        reps += 1;
+    }
+    2.0 * (m * k * n * reps) as f64 / t0.elapsed().as_secs_f64() / 1e9
+}
+
+/// Measures one architecture on 21-channel, 20-step windows for about `seconds` per figure.
+pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
+    let config = NetConfig {
+        architecture,
+        window: 20,
+        channels: 21,
+        outputs: 1,
+        dropout: 0.2,
+        seed: 1,
+    };
+    let mut net = Network::new(config);
+    let mut adam = Adam::new(net.params.value.len(), 1e-3);
+    let per = 20 * 21;
+    let x: Vec<f32> = (0..batch * per)
+        .map(|i| ((i as f32) * 0.618).sin())
+        .collect();
+    let y: Vec<f32> = (0..batch).map(|i| ((i as f32) * 0.1).cos()).collect();
+    let mut dout = vec![0.0f32; batch];
+    let mut done = 0usize;
+    let t0 = Instant::now();
+    while t0.elapsed().as_secs_f64() < seconds || done == 0 {
+        net.params.zero_grad();
+        let out = net.forward(&x, batch, true);
+        for ((d, p), t) in dout.iter_mut().zip(out).zip(&y) {
+            *d = 2.0 * (p - t) / batch as f32;
+        }
+        net.backward(&x, &dout);
+        adam.step(&mut net.params);
+        done += batch;
+    }
+    let train = done as f64 / t0.elapsed().as_secs_f64();
+    let big: Vec<f32> = (0..1024 * per)
+        .map(|i| ((i as f32) * 0.618).sin())
+        .collect();
+    let mut n = 0usize;
+    let t0 = Instant::now();
+    while t0.elapsed().as_secs_f64() < seconds || n == 0 {
+        std::hint::black_box(net.predict(&big, 1024));
+        n += 1024;
+    }
+    let infer = n as f64 / t0.elapsed().as_secs_f64();
+    let mut k = 0usize;
+    let t0 = Instant::now();
+    while t0.elapsed().as_secs_f64() < seconds / 2.0 || k == 0 {
+        std::hint::black_box(net.predict(&big[..per], 1));
+        k += 1;
+    }
+    NetBench {
+        architecture,
+        train_windows_per_s: train,
+        infer_windows_per_s: infer,
+        single_ms: t0.elapsed().as_secs_f64() * 1e3 / k as f64,
+        pytorch_train_reference: pytorch_reference(architecture),
+    }
+}

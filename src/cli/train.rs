@@ -1,0 +1,274 @@
+//! `railforce train` and `railforce evaluate`: thin shells over `learn::train` and
+//! `learn::evaluate`.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use railforce::features::{DataSet, LabelAt, NoiseProtocol, Selection, Split};
+use railforce::learn::evaluate::{EvalPart, evaluate};
+use railforce::learn::model::{Model, ModelKind};
+use railforce::learn::train::{Progress, TrainOptions, train};
+use railforce::learn::windows::DataSpec;
+use railforce::sim::output::PAPER_CHANNELS;
+use std::path::{Path, PathBuf};
+
+/// Data and split options shared by `train` and the experiments.
+#[derive(Debug, Args, Clone)]
+pub struct DataArgs {
+    /// Data set folder (written by `railforce generate`).
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Selection file from `railforce select` (channels, window, label position). Without it,
+    /// all 21 paper channels, window 20, label at the last step.
+    #[arg(long)]
+    pub selection: Option<PathBuf>,
+    /// Target: FL (lateral force, wheel 1 left), FQ (vertical), both, or a label channel name.
+    #[arg(long, default_value = "both")]
+    pub target: String,
+    /// Noise protocol: clean, train-clean-test-noisy, or matched (train and test on the
+    /// `_noisy` inputs). Default: matched when the data set has `_noisy` columns, else clean.
+    #[arg(long)]
+    pub noise: Option<String>,
+    /// Hold out whole conditions for the test (comma separated) instead of 70/15/15 blocks;
+    /// validation then uses `--val-conditions`.
+    #[arg(long, value_delimiter = ',')]
+    pub test_conditions: Vec<String>,
+    /// Conditions held out for validation (with --test-conditions).
+    #[arg(long, value_delimiter = ',')]
+    pub val_conditions: Vec<String>,
+    /// Stride of the training windows (validation and test always use 1).
+    #[arg(long, default_value_t = 1)]
+    pub stride: usize,
+}
+
+#[derive(Debug, Args)]
+pub struct TrainArgs {
+    #[command(flatten)]
+    data: DataArgs,
+    /// Model: cnn-bilstm, cnn, bilstm, gru, svr, gbdt, xgboost or tree.
+    #[arg(long, default_value = "cnn-bilstm")]
+    model: String,
+    /// Model directory to write (weights, model.json, train_log.jsonl, checkpoints).
+    #[arg(long)]
+    out: PathBuf,
+    /// Epochs at most (networks).
+    #[arg(long, default_value_t = 200)]
+    epochs: usize,
+    /// Early-stopping patience, epochs.
+    #[arg(long, default_value_t = 20)]
+    patience: usize,
+    /// Minibatch size.
+    #[arg(long, default_value_t = 64)]
+    batch: usize,
+    /// Adam learning rate.
+    #[arg(long, default_value_t = 1e-3)]
+    lr: f32,
+    /// Seed of weights, shuffling and dropout.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Training windows drawn per epoch at most (default: all).
+    #[arg(long)]
+    windows_per_epoch: Option<usize>,
+    /// Training windows a classical model is fitted on at most (evenly strided).
+    #[arg(long, default_value_t = 40_000)]
+    classical_rows: usize,
+    /// Continue from the checkpoint in --out (same data and settings).
+    #[arg(long)]
+    resume: bool,
+}
+
+/// Resolves the data options into a [`DataSpec`].
+pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
+    let (mut channels, window, label_at) = match &args.selection {
+        Some(p) => {
+            let text =
+                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            let s: Selection = serde_json::from_str(&text)
+                .with_context(|| format!("{}: not a selection file", p.display()))?;
+            (s.channels, s.window, s.label_at)
+        }
+        None => (
+            PAPER_CHANNELS.iter().map(|c| c.to_string()).collect(),
+            20,
+            LabelAt::Last,
+        ),
+    };
+    for c in &mut channels {
+        if let Some(base) = c.strip_suffix("_noisy") {
+            *c = base.to_string();
+        }
+    }
+    let targets: Vec<String> = match args.target.as_str() {
+        "both" => vec!["w1l_force_y".into(), "w1l_force_z".into()],
+        t => vec![railforce::features::target_channel(t)],
+    };
+    let has_noisy = channels
+        .iter()
+        .all(|c| ds.channel(&format!("{c}_noisy")).is_ok());
+    let noise = match args.noise.as_deref() {
+        None if has_noisy => NoiseProtocol::Matched,
+        None => NoiseProtocol::Clean,
+        Some("clean") => NoiseProtocol::Clean,
+        Some("matched") => NoiseProtocol::Matched,
+        Some("train-clean-test-noisy") => NoiseProtocol::TrainCleanTestNoisy,
+        Some(o) => bail!("--noise {o}: expected clean, matched or train-clean-test-noisy"),
+    };
+    let split = if args.test_conditions.is_empty() {
+        Split::default()
+    } else {
+        Split::Conditions {
+            val: args.val_conditions.clone(),
+            test: args.test_conditions.clone(),
+        }
+    };
+    Ok(DataSpec {
+        channels,
+        targets,
+        window,
+        label_at,
+        stride: args.stride,
+        split,
+        noise,
+    })
+}
+
+pub fn run(args: TrainArgs) -> Result<()> {
+    let kind = ModelKind::parse(&args.model)?;
+    let ds = DataSet::load(&args.data.data)?;
+    let spec = data_spec(&args.data, &ds)?;
+    let opts = TrainOptions {
+        epochs: args.epochs,
+        patience: args.patience,
+        batch: args.batch,
+        lr: args.lr,
+        seed: args.seed,
+        windows_per_epoch: args.windows_per_epoch,
+        classical_rows: args.classical_rows,
+        resume: args.resume,
+        ..TrainOptions::default()
+    };
+    println!(
+        "training {} on {} ({} runs): {} channels × {} steps → {}; noise {:?}; split {:?}",
+        kind.name(),
+        args.data.data.display(),
+        ds.runs.len(),
+        spec.channels.len(),
+        spec.window,
+        spec.targets.join(" + "),
+        spec.noise,
+        spec.split
+    );
+    let model = train_with_bar(&ds, &spec, kind, &opts, &args.out)?;
+    let t = &model.meta.training;
+    println!(
+        "model written to {}: {}",
+        args.out.display(),
+        serde_json::to_string(t)?
+    );
+    println!(
+        "next: railforce evaluate --model {} --data {}",
+        args.out.display(),
+        args.data.data.display()
+    );
+    Ok(())
+}
+
+/// Trains with a progress bar on standard error and one line per epoch.
+pub fn train_with_bar(
+    ds: &DataSet,
+    spec: &DataSpec,
+    kind: ModelKind,
+    opts: &TrainOptions,
+    out: &Path,
+) -> Result<Model> {
+    let bar = ProgressBar::new(1);
+    bar.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg}").expect("template"),
+    );
+    bar.set_prefix(kind.name());
+    let model = train(ds, spec, kind, opts, out, &mut |p| match p {
+        Progress::Batch { epoch, done, total } => {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+            bar.set_message(format!("epoch {epoch} batches"));
+        }
+        Progress::Epoch(e) => {
+            let r2: Vec<String> = e.val_r2.iter().map(|r| format!("{r:.3}")).collect();
+            bar.suspend(|| {
+                eprintln!(
+                    "epoch {:>3}: train {:.4}  val {:.4}  val R² {}  {:.0} windows/s  best {}",
+                    e.epoch,
+                    e.train_loss,
+                    e.val_loss,
+                    r2.join("/"),
+                    e.windows_per_s,
+                    e.best_epoch
+                )
+            });
+        }
+        Progress::Fit { done, total } => {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+            bar.set_message("fitting");
+        }
+    })?;
+    bar.finish_and_clear();
+    Ok(model)
+}
+
+#[derive(Debug, Args)]
+pub struct EvaluateArgs {
+    /// Model directory written by `railforce train`.
+    #[arg(long)]
+    model: PathBuf,
+    /// Data set folder.
+    #[arg(long)]
+    data: PathBuf,
+    /// Score every window of every run (data never used in training) instead of the test
+    /// blocks of the model's own split.
+    #[arg(long)]
+    all: bool,
+    /// Predictions CSV (default: MODEL/predictions.csv).
+    #[arg(long)]
+    predictions: Option<PathBuf>,
+}
+
+pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
+    let mut model = Model::load(&args.model)?;
+    let ds = DataSet::load(&args.data)?;
+    let part = if args.all {
+        EvalPart::All
+    } else {
+        EvalPart::Test
+    };
+    let ev = evaluate(&mut model, &ds, part)?;
+    println!(
+        "{} on {} ({}, noise {:?}), {} windows, {:.0} windows/s:",
+        model.meta.kind.name(),
+        args.data.display(),
+        if args.all {
+            "all windows"
+        } else {
+            "test blocks"
+        },
+        model.meta.data.noise,
+        ev.metrics.first().map(|m| m.n).unwrap_or(0),
+        ev.windows_per_s
+    );
+    println!(
+        "{:<14} {:>9} {:>9} {:>9} {:>10} {:>9}",
+        "target", "MSE", "R²", "Var(y)", "RMSE kN", "MAE kN"
+    );
+    for m in &ev.metrics {
+        println!(
+            "{:<14} {:>9.4} {:>9.4} {:>9.4} {:>10.3} {:>9.3}",
+            m.target, m.mse, m.r2, m.var_y, m.rmse_kn, m.mae_kn
+        );
+    }
+    let out = args
+        .predictions
+        .unwrap_or_else(|| args.model.join("predictions.csv"));
+    ev.write_csv(&out, &model.meta.data.targets)?;
+    println!("predictions: {}", out.display());
+    Ok(())
+}

@@ -1,0 +1,11 @@
+//! Learning: networks and classical regressors on leak-free windows, the trainer, metrics and
+//! model directories.
+
+pub mod classical;
+pub mod evaluate;
+pub mod linalg;
+pub mod metrics;
+pub mod model;
+pub mod neural;
+pub mod train;
+pub mod windows;

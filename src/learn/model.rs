@@ -1,0 +1,222 @@
+//! A trained model and its directory: `model.json` (kind, shape, data spec, z-score
+//! statistics, training summary) beside the weights (`weights.bin` for networks,
+//! `model.bin` for classical regressors). Everything `evaluate` and `identify` need.
+
+use super::classical::Classical;
+use super::neural::params::Slot;
+use super::neural::{Architecture, NetConfig, Network};
+use super::windows::DataSpec;
+use crate::error::{Error, Result};
+use crate::features::ZScore;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Every model of the comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ModelKind {
+    /// The paper's network.
+    CnnBiLstm,
+    /// Convolutional baseline.
+    Cnn,
+    /// BiLSTM baseline.
+    BiLstm,
+    /// GRU baseline.
+    Gru,
+    /// Support-vector regression, RBF kernel.
+    Svr,
+    /// Gradient-boosted trees (100 trees, depth 3, learning rate 0.1).
+    Gbdt,
+    /// XGBoost-style histogram boosting (300 trees, depth 6, learning rate 0.1).
+    Xgboost,
+    /// One regression tree.
+    Tree,
+}
+
+impl ModelKind {
+    /// All kinds in the paper's table order.
+    pub const ALL: [ModelKind; 8] = [
+        ModelKind::CnnBiLstm,
+        ModelKind::Cnn,
+        ModelKind::BiLstm,
+        ModelKind::Gru,
+        ModelKind::Svr,
+        ModelKind::Gbdt,
+        ModelKind::Xgboost,
+        ModelKind::Tree,
+    ];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::CnnBiLstm => "cnn-bilstm",
+            ModelKind::Cnn => "cnn",
+            ModelKind::BiLstm => "bilstm",
+            ModelKind::Gru => "gru",
+            ModelKind::Svr => "svr",
+            ModelKind::Gbdt => "gbdt",
+            ModelKind::Xgboost => "xgboost",
+            ModelKind::Tree => "tree",
+        }
+    }
+
+    /// Parses a command-line name.
+    pub fn parse(s: &str) -> Result<Self> {
+        ModelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<&str> = ModelKind::ALL.iter().map(|k| k.name()).collect();
+                Error::Domain(format!("unknown model `{s}` (one of {})", names.join(", ")))
+            })
+    }
+
+    /// The network architecture, for the neural kinds.
+    pub fn architecture(self) -> Option<Architecture> {
+        match self {
+            ModelKind::CnnBiLstm => Some(Architecture::CnnBiLstm),
+            ModelKind::Cnn => Some(Architecture::Cnn),
+            ModelKind::BiLstm => Some(Architecture::BiLstm),
+            ModelKind::Gru => Some(Architecture::Gru),
+            _ => None,
+        }
+    }
+}
+
+/// What `model.json` holds.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ModelMeta {
+    /// Kind.
+    pub kind: ModelKind,
+    /// Windows the model reads.
+    pub data: DataSpec,
+    /// Input statistics (training blocks only).
+    pub input_stats: ZScore,
+    /// Target statistics (training blocks only).
+    pub target_stats: ZScore,
+    /// Network shape (neural kinds).
+    pub net: Option<NetConfig>,
+    /// Weight layout (neural kinds).
+    pub slots: Option<Vec<Slot>>,
+    /// Data set identity: manifest hash and folder.
+    pub data_identity: serde_json::Value,
+    /// Training summary (epochs, best validation loss, timings, settings).
+    pub training: serde_json::Value,
+    /// railforce version that trained it.
+    pub version: String,
+}
+
+/// The fitted function.
+pub enum Engine {
+    /// A network.
+    Net(Box<Network>),
+    /// A classical regressor on flattened windows.
+    Classical(Box<Classical>),
+}
+
+/// A trained model.
+pub struct Model {
+    /// Metadata.
+    pub meta: ModelMeta,
+    /// Weights.
+    pub engine: Engine,
+}
+
+const MAGIC: &[u8; 8] = b"RFWEIGHT";
+
+impl Model {
+    /// Standardised predictions `[n, outputs]` for windows `x[n, window, channels]`.
+    pub fn predict(&mut self, x: &[f32], n: usize) -> Vec<f32> {
+        match &mut self.engine {
+            Engine::Net(net) => net.predict(x, n),
+            Engine::Classical(c) => c.predict(x, n),
+        }
+    }
+
+    /// Writes the model directory (atomically file by file).
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        let json = serde_json::to_string_pretty(&self.meta).expect("model metadata serialises");
+        crate::io::write_atomic(&dir.join("model.json"), |w| w.write_all(json.as_bytes()))?;
+        match &self.engine {
+            Engine::Net(net) => write_weights(&dir.join("weights.bin"), &net.params.value),
+            Engine::Classical(c) => {
+                let bytes = c.to_bytes();
+                crate::io::write_atomic(&dir.join("model.bin"), |w| w.write_all(&bytes))
+            }
+        }
+    }
+
+    /// Reads a model directory.
+    pub fn load(dir: &Path) -> Result<Self> {
+        let path = dir.join("model.json");
+        let text = crate::io::read_text(&path)?;
+        let meta: ModelMeta = serde_json::from_str(&text).map_err(|e| Error::Parse {
+            file: path.clone(),
+            message: e.to_string(),
+        })?;
+        let engine = if meta.kind.architecture().is_some() {
+            let config = meta
+                .net
+                .clone()
+                .ok_or_else(|| Error::config(&path, "net", "missing for a network"))?;
+            let mut net = Network::new(config);
+            if meta.slots.as_ref() != Some(&net.params.slots) {
+                return Err(Error::config(
+                    &path,
+                    "slots",
+                    "weight layout differs from this version's network",
+                ));
+            }
+            let values = read_weights(&dir.join("weights.bin"))?;
+            if values.len() != net.params.value.len() {
+                return Err(Error::config(
+                    &dir.join("weights.bin"),
+                    "values",
+                    format!(
+                        "{} weights, the network has {}",
+                        values.len(),
+                        net.params.value.len()
+                    ),
+                ));
+            }
+            net.params.value = values;
+            Engine::Net(Box::new(net))
+        } else {
+            let p = dir.join("model.bin");
+            let bytes = std::fs::read(&p).map_err(|e| Error::io(&p, e))?;
+            Engine::Classical(Box::new(
+                Classical::from_bytes(&bytes).map_err(|m| Error::config(&p, "model", &m))?,
+            ))
+        };
+        Ok(Model { meta, engine })
+    }
+}
+
+/// Writes f32 values: magic, count (u64 LE), values (f32 LE).
+pub fn write_weights(path: &Path, values: &[f32]) -> Result<()> {
+    crate::io::write_atomic(path, |w| {
+        w.write_all(MAGIC)?;
+        w.write_all(&(values.len() as u64).to_le_bytes())?;
+        for v in values {
+            w.write_all(&v.to_le_bytes())?;
+        }
+        Ok(())
+    })
+}
+
+/// Reads what [`write_weights`] wrote.
+pub fn read_weights(path: &Path) -> Result<Vec<f32>> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    if bytes.len() < 16 || &bytes[..8] != MAGIC {
+        return Err(Error::config(path, "header", "not a railforce weight file"));
+    }
+    let n = u64::from_le_bytes(bytes[8..16].try_into().expect("8 bytes")) as usize;
+    if bytes.len() != 16 + 4 * n {
+        return Err(Error::config(path, "length", "truncated weight file"));
+    }
+    Ok(bytes[16..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")))
+        .collect())
+}

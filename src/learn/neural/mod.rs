@@ -1,0 +1,14 @@
+//! Neural networks: the paper's CNN-BiLSTM and the CNN, BiLSTM and GRU baselines, with
+//! hand-fused forward and backward passes on f32 buffers (see the README for why not burn).
+
+pub mod adam;
+pub mod batch_norm;
+pub mod dense;
+pub mod gru;
+pub mod lstm;
+pub mod network;
+pub mod params;
+
+pub use adam::Adam;
+pub use network::{Architecture, NetConfig, Network};
+pub use params::ParamSet;

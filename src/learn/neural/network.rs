@@ -1,0 +1,354 @@
+//! The four networks of the paper's comparison on one skeleton: an optional convolutional stem
+//! (Conv1d k=1 → LeakyReLU → BatchNorm, twice, then MaxPool1d(2, stride 1) over time), a
+//! feature extractor (BiLSTM, GRU, or the flattened stem) and the shared head
+//! (Dropout → Linear(F→64) → LeakyReLU → Dropout → Linear(64→8) → LeakyReLU → Linear(8→out)).
+//! Forward and backward are written out by hand (fused, no per-op graph).
+
+use super::batch_norm::BatchNorm;
+use super::dense::Dense;
+use super::gru::Gru;
+use super::lstm::BiLstm;
+use super::params::ParamSet;
+use crate::learn::linalg::{leaky_relu, leaky_relu_backward};
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::SeedableRng;
+use serde::{Deserialize, Serialize};
+
+/// Network kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Architecture {
+    /// The paper's CNN-BiLSTM (spec learning.md §3).
+    CnnBiLstm,
+    /// The convolutional stem, flattened, and the head.
+    Cnn,
+    /// BiLSTM(C → 20 per direction) and the head.
+    BiLstm,
+    /// GRU(C → 20) and the head.
+    Gru,
+}
+
+impl Architecture {
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Architecture::CnnBiLstm => "cnn-bilstm",
+            Architecture::Cnn => "cnn",
+            Architecture::BiLstm => "bilstm",
+            Architecture::Gru => "gru",
+        }
+    }
+}
+
+/// Shape of a network.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NetConfig {
+    /// Kind.
+    pub architecture: Architecture,
+    /// Steps per window.
+    pub window: usize,
+    /// Input channels.
+    pub channels: usize,
+    /// Outputs (1 for FL or FQ, 2 for both).
+    pub outputs: usize,
+    /// Dropout probability of the head.
+    pub dropout: f32,
+    /// Seed of the initial weights and of dropout.
+    pub seed: u64,
+}
+
+const STEM_WIDTH: usize = 128;
+const HIDDEN: usize = 20;
+
+struct Stem {
+    c1: Dense,
+    bn1: BatchNorm,
+    c2: Dense,
+    bn2: BatchNorm,
+}
+
+enum Recurrent {
+    Lstm(BiLstm),
+    Gru(Gru),
+    None,
+}
+
+/// A network with its weights and the activations of the last forward pass.
+pub struct Network {
+    /// Shape.
+    pub config: NetConfig,
+    /// Weights, gradients and batch-norm statistics.
+    pub params: ParamSet,
+    stem: Option<Stem>,
+    rnn: Recurrent,
+    d1: Dense,
+    d2: Dense,
+    d3: Dense,
+    rng: ChaCha8Rng,
+    batch: usize,
+    r1: Vec<f32>,
+    n1: Vec<f32>,
+    r2: Vec<f32>,
+    n2: Vec<f32>,
+    pooled: Vec<f32>,
+    pick: Vec<bool>,
+    feat: Vec<f32>,
+    m0: Vec<f32>,
+    f0: Vec<f32>,
+    h1: Vec<f32>,
+    m1: Vec<f32>,
+    f1: Vec<f32>,
+    h2: Vec<f32>,
+    out: Vec<f32>,
+}
+
+impl Network {
+    /// A freshly initialised network (PyTorch's default initialisation), seeded.
+    pub fn new(config: NetConfig) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+        let mut p = ParamSet::default();
+        let c = config.channels;
+        let t = config.window;
+        let stem = matches!(
+            config.architecture,
+            Architecture::CnnBiLstm | Architecture::Cnn
+        )
+        .then(|| Stem {
+            c1: Dense::new(&mut p, "conv1", c, c, &mut rng),
+            bn1: BatchNorm::new(&mut p, "bn1", c),
+            c2: Dense::new(&mut p, "conv2", c, STEM_WIDTH, &mut rng),
+            bn2: BatchNorm::new(&mut p, "bn2", STEM_WIDTH),
+        });
+        let (rnn, feat) = match config.architecture {
+            Architecture::CnnBiLstm => {
+                let l = BiLstm::new(&mut p, "bilstm", STEM_WIDTH, HIDDEN, &mut rng);
+                let f = l.out_dim();
+                (Recurrent::Lstm(l), f)
+            }
+            Architecture::BiLstm => {
+                let l = BiLstm::new(&mut p, "bilstm", c, HIDDEN, &mut rng);
+                let f = l.out_dim();
+                (Recurrent::Lstm(l), f)
+            }
+            Architecture::Gru => {
+                let g = Gru::new(&mut p, "gru", c, HIDDEN, &mut rng);
+                let f = g.out_dim();
+                (Recurrent::Gru(g), f)
+            }
+            Architecture::Cnn => (Recurrent::None, (t - 1) * STEM_WIDTH),
+        };
+        let d1 = Dense::new(&mut p, "head.fc1", feat, 64, &mut rng);
+        let d2 = Dense::new(&mut p, "head.fc2", 64, 8, &mut rng);
+        let d3 = Dense::new(&mut p, "head.out", 8, config.outputs, &mut rng);
+        let dropout_rng = ChaCha8Rng::seed_from_u64(config.seed ^ 0x000D_80F0_u64);
+        Network {
+            config,
+            params: p,
+            stem,
+            rnn,
+            d1,
+            d2,
+            d3,
+            rng: dropout_rng,
+            batch: 0,
+            r1: Vec::new(),
+            n1: Vec::new(),
+            r2: Vec::new(),
+            n2: Vec::new(),
+            pooled: Vec::new(),
+            pick: Vec::new(),
+            feat: Vec::new(),
+            m0: Vec::new(),
+            f0: Vec::new(),
+            h1: Vec::new(),
+            m1: Vec::new(),
+            f1: Vec::new(),
+            h2: Vec::new(),
+            out: Vec::new(),
+        }
+    }
+
+    /// Re-seeds the dropout stream (the trainer does so per epoch for resumable runs).
+    pub fn reseed_dropout(&mut self, seed: u64) {
+        self.rng = ChaCha8Rng::seed_from_u64(seed);
+    }
+
+    /// Forward pass of `x[B, window, channels]` (z-scored); `train` enables dropout and batch
+    /// statistics. Returns `[B, outputs]`.
+    pub fn forward(&mut self, x: &[f32], batch: usize, train: bool) -> &[f32] {
+        let (t, c) = (self.config.window, self.config.channels);
+        assert_eq!(
+            x.len(),
+            batch * t * c,
+            "input must be [batch, window, channels]"
+        );
+        self.batch = batch;
+        let p = &mut self.params;
+        let mut tmp = Vec::new();
+        if let Some(stem) = &mut self.stem {
+            let rows = batch * t;
+            stem.c1.forward(p, x, rows, &mut self.r1);
+            leaky_relu(&mut self.r1);
+            self.n1.clone_from(&self.r1);
+            stem.bn1.forward(p, &mut self.n1, train);
+            stem.c2.forward(p, &self.n1, rows, &mut self.r2);
+            leaky_relu(&mut self.r2);
+            self.n2.clone_from(&self.r2);
+            stem.bn2.forward(p, &mut self.n2, train);
+            // MaxPool1d(2, stride 1) over time.
+            let w = STEM_WIDTH;
+            self.pooled.resize(batch * (t - 1) * w, 0.0);
+            self.pick
+                .resize(if train { self.pooled.len() } else { 0 }, false);
+            for b in 0..batch {
+                let src = &self.n2[b * t * w..(b + 1) * t * w];
+                let dst = &mut self.pooled[b * (t - 1) * w..(b + 1) * (t - 1) * w];
+                for (s, out) in dst.chunks_exact_mut(w).enumerate() {
+                    let (u, v) = (&src[s * w..(s + 1) * w], &src[(s + 1) * w..(s + 2) * w]);
+                    for ((o, &a), &c) in out.iter_mut().zip(u).zip(v) {
+                        *o = a.max(c);
+                    }
+                }
+                if train {
+                    let pick = &mut self.pick[b * (t - 1) * w..(b + 1) * (t - 1) * w];
+                    for (i, p) in pick.iter_mut().enumerate() {
+                        *p = src[i + w] > src[i];
+                    }
+                }
+            }
+        }
+        let seq: &[f32] = if self.stem.is_some() { &self.pooled } else { x };
+        let steps = if self.stem.is_some() { t - 1 } else { t };
+        match &mut self.rnn {
+            Recurrent::Lstm(l) => l.forward(p, seq, batch, steps, &mut self.feat),
+            Recurrent::Gru(g) => g.forward(p, seq, batch, steps, &mut self.feat),
+            Recurrent::None => self.feat.clone_from(&self.pooled),
+        }
+        let q = self.config.dropout;
+        dropout(
+            &self.feat,
+            &mut self.f0,
+            &mut self.m0,
+            q,
+            train,
+            &mut self.rng,
+        );
+        self.d1.forward(p, &self.f0, batch, &mut self.h1);
+        leaky_relu(&mut self.h1);
+        dropout(
+            &self.h1,
+            &mut self.f1,
+            &mut self.m1,
+            q,
+            train,
+            &mut self.rng,
+        );
+        self.d2.forward(p, &self.f1, batch, &mut self.h2);
+        leaky_relu(&mut self.h2);
+        self.d3.forward(p, &self.h2, batch, &mut tmp);
+        self.out = tmp;
+        &self.out
+    }
+
+    /// Backward pass from `dout[B, outputs]` after a training forward of `x`; accumulates the
+    /// gradients in `params.grad`.
+    pub fn backward(&mut self, x: &[f32], dout: &[f32]) {
+        let batch = self.batch;
+        let (t, c) = (self.config.window, self.config.channels);
+        let p = &mut self.params;
+        let mut dh2 = Vec::new();
+        self.d3.backward(p, &self.h2, dout, batch, Some(&mut dh2));
+        leaky_relu_backward(&self.h2, &mut dh2);
+        let mut dh1 = Vec::new();
+        self.d2.backward(p, &self.f1, &dh2, batch, Some(&mut dh1));
+        mul_in_place(&mut dh1, &self.m1);
+        leaky_relu_backward(&self.h1, &mut dh1);
+        let mut dfeat = Vec::new();
+        self.d1.backward(p, &self.f0, &dh1, batch, Some(&mut dfeat));
+        mul_in_place(&mut dfeat, &self.m0);
+        let Some(stem) = &mut self.stem else {
+            match &mut self.rnn {
+                Recurrent::Lstm(l) => l.backward(p, x, &dfeat, None),
+                Recurrent::Gru(g) => g.backward(p, x, &dfeat, None),
+                Recurrent::None => unreachable!("every network without a stem is recurrent"),
+            }
+            return;
+        };
+        let dpool = match &mut self.rnn {
+            Recurrent::Lstm(l) => {
+                let mut d = Vec::new();
+                l.backward(p, &self.pooled, &dfeat, Some(&mut d));
+                d
+            }
+            Recurrent::Gru(g) => {
+                let mut d = Vec::new();
+                g.backward(p, &self.pooled, &dfeat, Some(&mut d));
+                d
+            }
+            Recurrent::None => dfeat,
+        };
+        let w = STEM_WIDTH;
+        let mut dn2 = vec![0.0f32; batch * t * w];
+        let mut i = 0;
+        for b in 0..batch {
+            for s in 0..t - 1 {
+                let r0 = (b * t + s) * w;
+                for k in 0..w {
+                    let at = if self.pick[i] { r0 + w + k } else { r0 + k };
+                    dn2[at] += dpool[i];
+                    i += 1;
+                }
+            }
+        }
+        let rows = batch * t;
+        stem.bn2.backward(p, &mut dn2);
+        leaky_relu_backward(&self.r2, &mut dn2);
+        let mut dn1 = Vec::new();
+        stem.c2.backward(p, &self.n1, &dn2, rows, Some(&mut dn1));
+        stem.bn1.backward(p, &mut dn1);
+        leaky_relu_backward(&self.r1, &mut dn1);
+        stem.c1.backward(p, x, &dn1, rows, None);
+        debug_assert_eq!(x.len(), rows * c);
+    }
+
+    /// Predictions for `x[B, window, channels]` in evaluation mode, in chunks of 1024 windows.
+    pub fn predict(&mut self, x: &[f32], batch: usize) -> Vec<f32> {
+        let per = self.config.window * self.config.channels;
+        let mut out = Vec::with_capacity(batch * self.config.outputs);
+        for chunk in x.chunks(per * 1024) {
+            let n = chunk.len() / per;
+            out.extend_from_slice(self.forward(chunk, n, false));
+        }
+        out
+    }
+}
+
+/// Inverted dropout: `y = x·m`, `m ∈ {0, 1/(1−q)}`; identity (mask 1) outside training.
+fn dropout(
+    x: &[f32],
+    y: &mut Vec<f32>,
+    mask: &mut Vec<f32>,
+    q: f32,
+    train: bool,
+    rng: &mut ChaCha8Rng,
+) {
+    mask.clear();
+    if train && q > 0.0 {
+        let keep = 1.0 / (1.0 - q);
+        mask.extend(
+            x.iter()
+                .map(|_| if rng.random::<f32>() < q { 0.0 } else { keep }),
+        );
+    } else {
+        mask.resize(x.len(), 1.0);
+    }
+    y.clear();
+    y.extend(x.iter().zip(mask.iter()).map(|(a, m)| a * m));
+}
+
+fn mul_in_place(x: &mut [f32], m: &[f32]) {
+    for (a, b) in x.iter_mut().zip(m) {
+        *a *= b;
+    }
+}

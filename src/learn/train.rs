@@ -1,0 +1,408 @@
+//! Training: networks by minibatch Adam on MSE with early stopping on the validation loss
+//! (best weights restored), checkpoints every epoch that `--resume` continues from, and a JSON
+//! lines log; classical models fitted once on (a strided subsample of) the training windows.
+
+use super::classical::{Classical, ClassicalParams};
+use super::metrics::metrics;
+use super::model::{Engine, Model, ModelKind, ModelMeta, read_weights, write_weights};
+use super::neural::{Adam, NetConfig, Network};
+use super::windows::{DataSpec, WindowSet, prepare};
+use crate::error::{Error, Result};
+use crate::features::DataSet;
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::SeedableRng;
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use std::path::Path;
+use std::time::Instant;
+
+/// Training settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainOptions {
+    /// Epochs at most.
+    pub epochs: usize,
+    /// Early-stopping patience (epochs without a better validation loss).
+    pub patience: usize,
+    /// Minibatch size.
+    pub batch: usize,
+    /// Adam learning rate.
+    pub lr: f32,
+    /// Seed of weights, shuffling and dropout.
+    pub seed: u64,
+    /// Head dropout.
+    pub dropout: f32,
+    /// Training windows drawn per epoch at most (all when `None`).
+    pub windows_per_epoch: Option<usize>,
+    /// Training windows a classical model is fitted on at most (evenly strided).
+    pub classical_rows: usize,
+    /// Continue from the checkpoint in the output folder.
+    pub resume: bool,
+}
+
+impl Default for TrainOptions {
+    fn default() -> Self {
+        TrainOptions {
+            epochs: 200,
+            patience: 20,
+            batch: 64,
+            lr: 1e-3,
+            seed: 1,
+            dropout: 0.2,
+            windows_per_epoch: None,
+            classical_rows: 40_000,
+            resume: false,
+        }
+    }
+}
+
+/// One line of `train_log.jsonl`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EpochLog {
+    /// Epoch (1-based).
+    pub epoch: usize,
+    /// Mean training loss (standardised MSE, dropout on).
+    pub train_loss: f64,
+    /// Validation MSE (standardised, mean over outputs).
+    pub val_loss: f64,
+    /// Validation R² per output.
+    pub val_r2: Vec<f64>,
+    /// Training windows per second this epoch.
+    pub windows_per_s: f64,
+    /// Wall time of the epoch, s.
+    pub seconds: f64,
+    /// Best epoch so far.
+    pub best_epoch: usize,
+}
+
+/// What the trainer reports while it works.
+#[derive(Debug, Clone)]
+pub enum Progress {
+    /// Minibatch `done` of `total` in `epoch`.
+    Batch {
+        /// Epoch (1-based).
+        epoch: usize,
+        /// Batches done.
+        done: usize,
+        /// Batches this epoch.
+        total: usize,
+    },
+    /// An epoch finished.
+    Epoch(EpochLog),
+    /// A classical fit advanced (trees or outputs).
+    Fit {
+        /// Units done.
+        done: usize,
+        /// Units in all.
+        total: usize,
+    },
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Checkpoint {
+    epoch: usize,
+    best_val: f64,
+    best_epoch: usize,
+    bad_epochs: usize,
+    adam_t: u64,
+    fingerprint: String,
+}
+
+/// Trains `kind` on `ds` and writes the model directory `out`.
+pub fn train(
+    ds: &DataSet,
+    spec: &DataSpec,
+    kind: ModelKind,
+    opts: &TrainOptions,
+    out: &Path,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Model> {
+    if opts.batch == 0
+        || opts.epochs == 0
+        || opts.lr.is_nan()
+        || opts.lr <= 0.0
+        || !(0.0..1.0).contains(&opts.dropout)
+    {
+        return Err(Error::Domain(
+            "batch and epochs must be ≥ 1, lr > 0 and 0 ≤ dropout < 1".into(),
+        ));
+    }
+    let t0 = Instant::now();
+    let prep = prepare(ds, spec, None)?;
+    if prep.train.is_empty() || prep.val.is_empty() {
+        return Err(Error::Domain(format!(
+            "the split leaves {} training and {} validation windows: need both",
+            prep.train.len(),
+            prep.val.len()
+        )));
+    }
+    let manifest = ds.dir.join("manifest.json");
+    let identity = json!({
+        "folder": ds.dir.display().to_string(),
+        "manifest_fnv1a": crate::dataset::file_hash(&manifest)?,
+        "runs": ds.runs.len(),
+    });
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let mut meta = ModelMeta {
+        kind,
+        data: spec.clone(),
+        input_stats: prep.input_stats.clone(),
+        target_stats: prep.target_stats.clone(),
+        net: None,
+        slots: None,
+        data_identity: identity,
+        training: json!({}),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    let engine = match kind.architecture() {
+        Some(architecture) => {
+            let config = NetConfig {
+                architecture,
+                window: spec.window,
+                channels: spec.channels.len(),
+                outputs: spec.targets.len(),
+                dropout: opts.dropout,
+                seed: opts.seed,
+            };
+            let (net, summary) = train_network(
+                config.clone(),
+                &prep.train,
+                &prep.val,
+                opts,
+                out,
+                &meta,
+                progress,
+            )?;
+            meta.slots = Some(net.params.slots.clone());
+            meta.net = Some(config);
+            meta.training = summary;
+            Engine::Net(Box::new(net))
+        }
+        None => {
+            let params = match kind {
+                ModelKind::Svr => ClassicalParams::svr(),
+                ModelKind::Gbdt => ClassicalParams::gbdt(),
+                ModelKind::Xgboost => ClassicalParams::xgboost(),
+                _ => ClassicalParams::tree(),
+            };
+            let step = prep.train.len().div_ceil(opts.classical_rows.max(1)).max(1);
+            let idx: Vec<usize> = (0..prep.train.len()).step_by(step).collect();
+            let (mut x, mut y) = (Vec::new(), Vec::new());
+            prep.train.gather(&idx, &mut x, &mut y);
+            let tf = Instant::now();
+            let model = Classical::fit(
+                params,
+                &x,
+                prep.train.features(),
+                &y,
+                prep.train.outputs,
+                &mut |done, total| progress(Progress::Fit { done, total }),
+            );
+            let fit_s = tf.elapsed().as_secs_f64();
+            let (vx, vy) = prep.val.all();
+            let vp = model.predict(&vx, prep.val.len());
+            let vm = metrics(&vy, &vp, &prep.target_stats);
+            meta.training = json!({
+                "params": params,
+                "fitted_rows": model.fitted_rows,
+                "training_windows": prep.train.len(),
+                "features": prep.train.features(),
+                "fit_seconds": fit_s,
+                "val_loss": vm.iter().map(|m| m.mse).sum::<f64>() / vm.len() as f64,
+                "val_r2": vm.iter().map(|m| m.r2).collect::<Vec<_>>(),
+            });
+            Engine::Classical(Box::new(model))
+        }
+    };
+    if let Some(obj) = meta.training.as_object_mut() {
+        obj.insert("wall_seconds".into(), json!(t0.elapsed().as_secs_f64()));
+        obj.insert(
+            "options".into(),
+            serde_json::to_value(opts).expect("options serialise"),
+        );
+    }
+    let model = Model { meta, engine };
+    model.save(out)?;
+    Ok(model)
+}
+
+fn train_network(
+    config: NetConfig,
+    train: &WindowSet,
+    val: &WindowSet,
+    opts: &TrainOptions,
+    out: &Path,
+    meta: &ModelMeta,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(Network, serde_json::Value)> {
+    let mut net = Network::new(config.clone());
+    let mut adam = Adam::new(net.params.value.len(), opts.lr);
+    let fingerprint = crate::dataset::fnv1a(
+        serde_json::to_string(&(
+            &config,
+            &meta.data,
+            &meta.data_identity,
+            opts.batch,
+            opts.lr,
+            opts.windows_per_epoch,
+        ))
+        .expect("serialises")
+        .as_bytes(),
+    );
+    let ck_path = out.join("checkpoint.json");
+    let log_path = out.join("train_log.jsonl");
+    let mut log: Vec<EpochLog> = Vec::new();
+    let mut best = net.params.value.clone();
+    let (mut best_val, mut best_epoch, mut bad, mut start) =
+        (f64::INFINITY, 0usize, 0usize, 0usize);
+    if opts.resume && ck_path.exists() {
+        let text = crate::io::read_text(&ck_path)?;
+        let ck: Checkpoint = serde_json::from_str(&text).map_err(|e| Error::Parse {
+            file: ck_path.clone(),
+            message: e.to_string(),
+        })?;
+        if ck.fingerprint != fingerprint {
+            return Err(Error::config(
+                &ck_path,
+                "fingerprint",
+                "the checkpoint belongs to another model, data set or setting; train without --resume or into another folder",
+            ));
+        }
+        net.params.value = read_weights(&out.join("checkpoint_weights.bin"))?;
+        best = read_weights(&out.join("checkpoint_best.bin"))?;
+        let mv = read_weights(&out.join("checkpoint_adam.bin"))?;
+        let n = net.params.value.len();
+        if best.len() != n || mv.len() != 2 * n {
+            return Err(Error::config(
+                &ck_path,
+                "weights",
+                "checkpoint files do not match the network",
+            ));
+        }
+        adam.m = mv[..n].to_vec();
+        adam.v = mv[n..].to_vec();
+        adam.t = ck.adam_t;
+        (best_val, best_epoch, bad, start) = (ck.best_val, ck.best_epoch, ck.bad_epochs, ck.epoch);
+        log = crate::io::read_text(&log_path)?
+            .lines()
+            .filter_map(|l| serde_json::from_str::<EpochLog>(l).ok())
+            .filter(|e| e.epoch <= start)
+            .collect();
+    }
+    let (mut x, mut y, mut dout) = (Vec::new(), Vec::new(), Vec::new());
+    let (vx, vy) = val.all();
+    let batch = opts.batch;
+    let mut stopped_early = false;
+    for epoch in start + 1..=opts.epochs {
+        if bad >= opts.patience {
+            stopped_early = true;
+            break;
+        }
+        let te = Instant::now();
+        let mut order: Vec<usize> = (0..train.len()).collect();
+        let mut rng =
+            ChaCha8Rng::seed_from_u64(opts.seed.wrapping_mul(1_000_003).wrapping_add(epoch as u64));
+        for i in (1..order.len()).rev() {
+            let j = rng.random_range(0..=i);
+            order.swap(i, j);
+        }
+        if let Some(cap) = opts.windows_per_epoch {
+            order.truncate(cap.max(batch));
+        }
+        net.reseed_dropout(opts.seed ^ (epoch as u64).wrapping_mul(0x9E37_79B9));
+        let batches = order.len().div_ceil(batch);
+        let mut loss_sum = 0.0f64;
+        for (bi, chunk) in order.chunks(batch).enumerate() {
+            train.gather(chunk, &mut x, &mut y);
+            net.params.zero_grad();
+            let pred = net.forward(&x, chunk.len(), true);
+            dout.clear();
+            let scale = 2.0 / y.len() as f32;
+            let mut l = 0.0f64;
+            for (p, t) in pred.iter().zip(&y) {
+                let e = p - t;
+                l += (e * e) as f64;
+                dout.push(scale * e);
+            }
+            let l = l / y.len() as f64;
+            if !l.is_finite() {
+                return Err(Error::Domain(format!(
+                    "training diverged at epoch {epoch}, batch {} (loss {l}); lower --lr",
+                    bi + 1
+                )));
+            }
+            loss_sum += l * chunk.len() as f64;
+            net.backward(&x, &dout);
+            adam.step(&mut net.params);
+            if bi % 16 == 0 || bi + 1 == batches {
+                progress(Progress::Batch {
+                    epoch,
+                    done: bi + 1,
+                    total: batches,
+                });
+            }
+        }
+        let train_s = te.elapsed().as_secs_f64();
+        let vp = net.predict(&vx, val.len());
+        let vm = metrics(&vy, &vp, &meta.target_stats);
+        let val_loss = vm.iter().map(|m| m.mse).sum::<f64>() / vm.len() as f64;
+        if !val_loss.is_finite() {
+            return Err(Error::Domain(format!(
+                "validation loss is {val_loss} at epoch {epoch}; lower --lr"
+            )));
+        }
+        if val_loss < best_val {
+            best_val = val_loss;
+            best_epoch = epoch;
+            best.clone_from(&net.params.value);
+            bad = 0;
+        } else {
+            bad += 1;
+        }
+        let entry = EpochLog {
+            epoch,
+            train_loss: loss_sum / order.len() as f64,
+            val_loss,
+            val_r2: vm.iter().map(|m| m.r2).collect(),
+            windows_per_s: order.len() as f64 / train_s,
+            seconds: te.elapsed().as_secs_f64(),
+            best_epoch,
+        };
+        log.push(entry.clone());
+        // Checkpoint: weights, best weights, Adam moments, counters, log.
+        write_weights(&out.join("checkpoint_weights.bin"), &net.params.value)?;
+        write_weights(&out.join("checkpoint_best.bin"), &best)?;
+        let mut mv = adam.m.clone();
+        mv.extend_from_slice(&adam.v);
+        write_weights(&out.join("checkpoint_adam.bin"), &mv)?;
+        let lines: String = log
+            .iter()
+            .map(|e| serde_json::to_string(e).expect("log serialises") + "\n")
+            .collect();
+        crate::io::write_atomic(&log_path, |w| w.write_all(lines.as_bytes()))?;
+        let ck = Checkpoint {
+            epoch,
+            best_val,
+            best_epoch,
+            bad_epochs: bad,
+            adam_t: adam.t,
+            fingerprint: fingerprint.clone(),
+        };
+        let ckj = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");
+        crate::io::write_atomic(&ck_path, |w| w.write_all(ckj.as_bytes()))?;
+        progress(Progress::Epoch(entry));
+    }
+    net.params.value = best;
+    let mean_rate = log.iter().map(|e| e.windows_per_s).sum::<f64>() / log.len().max(1) as f64;
+    let summary = json!({
+        "epochs_run": log.len(),
+        "best_epoch": best_epoch,
+        "best_val_loss": best_val,
+        "stopped_early": stopped_early || bad >= opts.patience,
+        "training_windows": train.len(),
+        "validation_windows": val.len(),
+        "parameters": net.params.trainable_count(),
+        "mean_windows_per_s": mean_rate,
+    });
+    Ok((net, summary))
+}

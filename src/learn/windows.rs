@@ -1,0 +1,195 @@
+//! Standardised windows ready for the learners: each run's selected input columns interleaved
+//! row-major (`[rows × C]` f32, so a window is one contiguous slice) and its standardised
+//! targets. Built per part from the leak-free [`Samples`] with the statistics of the training
+//! blocks only (spec learning.md §1).
+
+use crate::error::{Error, Result};
+use crate::features::{DataSet, LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
+use serde::{Deserialize, Serialize};
+
+/// What a model is trained on: everything needed to rebuild the same windows later.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DataSpec {
+    /// Input channels (clean names; `_noisy` copies are read where the protocol says).
+    pub channels: Vec<String>,
+    /// Label channels (one or two).
+    pub targets: Vec<String>,
+    /// Steps per window.
+    pub window: usize,
+    /// Label position.
+    pub label_at: LabelAt,
+    /// Stride of training windows (validation and test use 1).
+    pub stride: usize,
+    /// How runs are split.
+    pub split: Split,
+    /// Which inputs each part reads.
+    pub noise: NoiseProtocol,
+}
+
+/// Windows of one part.
+#[derive(Debug, Clone)]
+pub struct WindowSet {
+    /// Steps per window.
+    pub window: usize,
+    /// Input channels.
+    pub channels: usize,
+    /// Outputs.
+    pub outputs: usize,
+    /// The windows (run, first step).
+    pub windows: Vec<Window>,
+    label_offset: usize,
+    x: Vec<Vec<f32>>,
+    y: Vec<Vec<f32>>,
+}
+
+impl WindowSet {
+    /// Number of windows.
+    pub fn len(&self) -> usize {
+        self.windows.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.windows.is_empty()
+    }
+
+    /// Values per window (`window × channels`).
+    pub fn features(&self) -> usize {
+        self.window * self.channels
+    }
+
+    /// Copies the windows `idx` into `x[n, window, channels]` and their labels into
+    /// `y[n, outputs]`.
+    pub fn gather(&self, idx: &[usize], x: &mut Vec<f32>, y: &mut Vec<f32>) {
+        let per = self.features();
+        x.clear();
+        y.clear();
+        x.reserve(idx.len() * per);
+        for &i in idx {
+            let w = self.windows[i];
+            let (r, s) = (w.run as usize, w.start as usize);
+            x.extend_from_slice(&self.x[r][s * self.channels..s * self.channels + per]);
+            let l = (s + self.label_offset) * self.outputs;
+            y.extend_from_slice(&self.y[r][l..l + self.outputs]);
+        }
+    }
+
+    /// All windows, in order.
+    pub fn all(&self) -> (Vec<f32>, Vec<f32>) {
+        let idx: Vec<usize> = (0..self.len()).collect();
+        let (mut x, mut y) = (Vec::new(), Vec::new());
+        self.gather(&idx, &mut x, &mut y);
+        (x, y)
+    }
+
+    /// Row (time step) of window `i`'s label in its run.
+    pub fn label_row(&self, i: usize) -> (usize, usize) {
+        let w = self.windows[i];
+        (w.run as usize, w.start as usize + self.label_offset)
+    }
+}
+
+/// The three parts and their statistics.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// Training windows.
+    pub train: WindowSet,
+    /// Validation windows.
+    pub val: WindowSet,
+    /// Test windows.
+    pub test: WindowSet,
+    /// Input statistics (training blocks, training view).
+    pub input_stats: ZScore,
+    /// Target statistics (training blocks).
+    pub target_stats: ZScore,
+}
+
+/// Label offset inside a window.
+pub fn label_offset(window: usize, label_at: LabelAt) -> usize {
+    match label_at {
+        LabelAt::Last => window - 1,
+        LabelAt::Centre => window / 2,
+    }
+}
+
+/// Builds the windows of a data set. Statistics are fitted here unless given (a trained model
+/// evaluated on new data brings its own).
+pub fn prepare(
+    ds: &DataSet,
+    spec: &DataSpec,
+    stats: Option<(&ZScore, &ZScore)>,
+) -> Result<Prepared> {
+    if spec.channels.is_empty() || spec.targets.is_empty() {
+        return Err(Error::Domain("no input channels or no targets".into()));
+    }
+    let samples = Samples::build(ds, &spec.split, spec.window, spec.stride, spec.label_at)?;
+    let view = |part: Part| -> Result<Vec<usize>> {
+        spec.channels
+            .iter()
+            .map(|c| {
+                let name = spec.noise.column(c, part);
+                ds.channel(&name).map_err(|_| {
+                    Error::Domain(format!(
+                        "the data set in {} has no column `{name}` (noise protocol {:?}; generate with --snr-db for `_noisy` inputs)",
+                        ds.dir.display(),
+                        spec.noise
+                    ))
+                })
+            })
+            .collect()
+    };
+    let (train_cols, val_cols, test_cols) =
+        (view(Part::Train)?, view(Part::Val)?, view(Part::Test)?);
+    let target_cols = spec
+        .targets
+        .iter()
+        .map(|t| ds.channel(t))
+        .collect::<Result<Vec<_>>>()?;
+    let (input_stats, target_stats) = match stats {
+        Some((i, t)) => (i.clone(), t.clone()),
+        None => (
+            ZScore::fit(ds, &samples.train_blocks, &train_cols),
+            ZScore::fit(ds, &samples.train_blocks, &target_cols),
+        ),
+    };
+    let offset = label_offset(spec.window, spec.label_at);
+    let y: Vec<Vec<f32>> = ds
+        .runs
+        .iter()
+        .map(|r| interleave(r, &target_cols, &target_stats))
+        .collect();
+    let set = |cols: &[usize], windows: &[Window]| -> WindowSet {
+        WindowSet {
+            window: spec.window,
+            channels: cols.len(),
+            outputs: target_cols.len(),
+            windows: windows.to_vec(),
+            label_offset: offset,
+            x: ds
+                .runs
+                .iter()
+                .map(|r| interleave(r, cols, &input_stats))
+                .collect(),
+            y: y.clone(),
+        }
+    };
+    Ok(Prepared {
+        train: set(&train_cols, &samples.train),
+        val: set(&val_cols, &samples.val),
+        test: set(&test_cols, &samples.test),
+        input_stats,
+        target_stats,
+    })
+}
+
+/// A run's columns standardised and interleaved row-major.
+fn interleave(run: &crate::features::Run, cols: &[usize], z: &ZScore) -> Vec<f32> {
+    let n = run.len();
+    let mut out = vec![0.0f32; n * cols.len()];
+    for (k, &c) in cols.iter().enumerate() {
+        for (i, v) in run.columns[c].iter().enumerate() {
+            out[i * cols.len() + k] = z.apply(k, *v) as f32;
+        }
+    }
+    out
+}
