@@ -101,3 +101,41 @@ pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
         pytorch_train_reference: pytorch_reference(architecture),
     }
 }
+
+/// Seconds to fit `params` on `n` synthetic windows of `f` features (one output), and the
+/// test R² reached (a smooth nonlinear function of a few features, so the fit is real work).
+pub fn classical_fit(
+    params: crate::learn::classical::ClassicalParams,
+    n: usize,
+    f: usize,
+) -> (f64, f64) {
+    use crate::learn::classical::Classical;
+    let make = |n: usize, seed: u64| -> (Vec<f32>, Vec<f32>) {
+        let mut s = seed;
+        let x: Vec<f32> = (0..n * f)
+            .map(|_| {
+                s = s
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                ((s >> 40) as f32 / (1u64 << 24) as f32) * 3.0 - 1.5
+            })
+            .collect();
+        let y = (0..n)
+            .map(|r| {
+                let v = &x[r * f..];
+                (2.0 * v[0]).sin() * v[1] + v[2] * v[2] + 0.5 * v[f / 2] * v[f - 1]
+            })
+            .collect();
+        (x, y)
+    };
+    let (x, y) = make(n, 1);
+    let t0 = Instant::now();
+    let m = Classical::fit(params, &x, f, &y, 1, &mut |_, _| {});
+    let secs = t0.elapsed().as_secs_f64();
+    let (xt, yt) = make(2000, 2);
+    let p = m.predict(&xt, 2000);
+    let mean = yt.iter().sum::<f32>() / yt.len() as f32;
+    let sst: f32 = yt.iter().map(|v| (v - mean).powi(2)).sum();
+    let sse: f32 = yt.iter().zip(&p).map(|(a, b)| (a - b).powi(2)).sum();
+    (secs, (1.0 - sse / sst) as f64)
+}

@@ -11,6 +11,17 @@ pub struct BenchArgs {
 
 #[derive(Debug, Subcommand)]
 enum What {
+    /// Training and inference throughput of the four networks (windows/s, one thread, batch
+    /// 64, 21 channels × 20 steps) beside the PyTorch figures of the spec and this machine's
+    /// GEMM rate; then the fit time of XGBoost-style and GBDT boosting on synthetic windows.
+    Learn {
+        /// Seconds per network figure.
+        #[arg(long, default_value_t = 3.0)]
+        seconds: f64,
+        /// Rows of the boosting fit (0 skips it).
+        #[arg(long, default_value_t = 40_000)]
+        rows: usize,
+    },
     /// One wheel's contact evaluation during a simulation step (table lookup + Hertz +
     /// creepages + Polach), against FASTSIM and a full rigid solve measured in the same run.
     /// Build with --release for meaningful numbers.
@@ -43,6 +54,54 @@ enum What {
 
 pub fn run(args: BenchArgs) -> Result<()> {
     match args.what {
+        What::Learn { seconds, rows } => {
+            use railforce::bench::learn;
+            use railforce::learn::neural::Architecture as A;
+            if cfg!(debug_assertions) {
+                eprintln!("warning: debug build; use `cargo run --release -- bench learn`");
+            }
+            let gf = learn::gemm_gflops();
+            println!("GEMM [1216×128]·[128×160], one thread: {gf:.1} GFLOP/s (hardware reference)");
+            println!(
+                "{:<11} {:>14} {:>10} {:>12} {:>14} {:>12}",
+                "network",
+                "train win/s",
+                "vs PyTorch",
+                "infer win/s",
+                "single window",
+                "train/GFLOP"
+            );
+            for a in [A::CnnBiLstm, A::Cnn, A::BiLstm, A::Gru] {
+                let b = learn::run(a, 64, seconds);
+                println!(
+                    "{:<11} {:>14.0} {:>9.2}× {:>12.0} {:>11.3} ms {:>12.1}",
+                    a.name(),
+                    b.train_windows_per_s,
+                    b.train_windows_per_s / b.pytorch_train_reference,
+                    b.infer_windows_per_s,
+                    b.single_ms,
+                    b.train_windows_per_s / gf
+                );
+            }
+            if rows > 0 {
+                use railforce::learn::classical::ClassicalParams;
+                for (name, p, reference) in [
+                    (
+                        "xgboost (300 trees, depth 6)",
+                        ClassicalParams::xgboost(),
+                        Some(34.0),
+                    ),
+                    ("gbdt (100 trees, depth 3)", ClassicalParams::gbdt(), None),
+                ] {
+                    let (s, r2) = learn::classical_fit(p, rows, 420);
+                    let refs = reference
+                        .map(|r| format!(", XGBoost reference {r:.0} s: {:.2}×", r / s))
+                        .unwrap_or_default();
+                    println!("{name}: fit {rows} × 420 in {s:.1} s (test R² {r2:.3}{refs})");
+                }
+            }
+            Ok(())
+        }
         What::Simulate {
             vehicle,
             track,

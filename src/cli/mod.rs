@@ -76,7 +76,8 @@ enum Command {
     Evaluate(train::EvaluateArgs),
     /// Check railforce against reference solutions (`validate contact`, `validate dynamics`).
     Validate(validate::ValidateArgs),
-    /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`).
+    /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
+    /// `bench learn`).
     Bench(bench::BenchArgs),
 }
 

@@ -139,7 +139,7 @@ pub fn train(
     let manifest = ds.dir.join("manifest.json");
     let identity = json!({
         "folder": ds.dir.display().to_string(),
-        "manifest_fnv1a": crate::dataset::file_hash(&manifest)?,
+        "manifest_fnv1a": crate::dataset::file_hash(&manifest).ok(),
         "runs": ds.runs.len(),
     });
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;

@@ -78,7 +78,9 @@ impl Tree {
             depth: usize,
             hist: Hist,
         }
-        let root = Hist::build(xb, f, nb, grad, rows);
+        // Histogram buffers are recycled: each is f × 256 bins (1.3 MB for 420 features).
+        let mut pool: Vec<Hist> = Vec::new();
+        let root = Hist::build(xb, f, nb, grad, rows, &mut pool);
         let mut open = vec![Open {
             node: 0,
             from: 0,
@@ -90,9 +92,11 @@ impl Tree {
             let (g, c) = o.hist.totals(nb);
             nodes[o.node].value = (-g / (c as f64 + p.lambda)) as f32;
             if o.depth >= p.max_depth || c < 2 * p.min_leaf as u64 {
+                pool.push(o.hist);
                 continue;
             }
             let Some((feat, bin)) = o.hist.best_split(f, nb, bins, p) else {
+                pool.push(o.hist);
                 continue;
             };
             // Partition rows in place: bins ≤ `bin` first.
@@ -122,8 +126,9 @@ impl Tree {
             } else {
                 &rows[mid..o.to]
             };
-            let hs = Hist::build(xb, f, nb, grad, small);
-            let hl = o.hist.minus(&hs);
+            let hs = Hist::build(xb, f, nb, grad, small, &mut pool);
+            let mut hl = o.hist;
+            hl.subtract(&hs);
             let (hleft, hright) = if left_small { (hs, hl) } else { (hl, hs) };
             open.push(Open {
                 node: l,
@@ -155,68 +160,81 @@ fn leaf(value: f32) -> Node {
     }
 }
 
-/// Gradient sums and counts per (feature, bin).
+/// Gradient sums and counts per (feature, bin), interleaved (one cache line per update).
 struct Hist {
-    g: Vec<f64>,
-    c: Vec<u32>,
+    gc: Vec<[f32; 2]>,
 }
 
 impl Hist {
-    fn build(xb: &[u8], f: usize, nb: usize, grad: &[f32], rows: &[u32]) -> Hist {
-        let mut g = vec![0.0f64; f * nb];
-        let mut c = vec![0u32; f * nb];
+    fn build(
+        xb: &[u8],
+        f: usize,
+        nb: usize,
+        grad: &[f32],
+        rows: &[u32],
+        pool: &mut Vec<Hist>,
+    ) -> Hist {
+        let mut gc = pool.pop().map(|h| h.gc).unwrap_or_default();
+        gc.clear();
+        gc.resize(f * nb, [0.0; 2]);
         for &r in rows {
             let row = &xb[r as usize * f..(r as usize + 1) * f];
-            let gr = grad[r as usize] as f64;
+            let gr = grad[r as usize];
             for (j, &b) in row.iter().enumerate() {
-                let k = j * nb + b as usize;
-                g[k] += gr;
-                c[k] += 1;
+                let e = &mut gc[j * nb + b as usize];
+                e[0] += gr;
+                e[1] += 1.0;
             }
         }
-        Hist { g, c }
+        Hist { gc }
     }
 
-    fn minus(&self, other: &Hist) -> Hist {
-        Hist {
-            g: self.g.iter().zip(&other.g).map(|(a, b)| a - b).collect(),
-            c: self.c.iter().zip(&other.c).map(|(a, b)| a - b).collect(),
+    /// `self −= other` (parent minus the smaller child gives the larger child).
+    fn subtract(&mut self, other: &Hist) {
+        for (a, b) in self.gc.iter_mut().zip(&other.gc) {
+            a[0] -= b[0];
+            a[1] -= b[1];
         }
     }
 
     fn totals(&self, nb: usize) -> (f64, u64) {
-        (
-            self.g[..nb].iter().sum(),
-            self.c[..nb].iter().map(|&c| c as u64).sum(),
-        )
+        let g = self.gc[..nb].iter().map(|e| e[0] as f64).sum();
+        let c = self.gc[..nb].iter().map(|e| e[1] as f64).sum::<f64>();
+        (g, c.round() as u64)
     }
 
     /// Best (feature, last left bin) by the gain `G_L²/(n_L+λ) + G_R²/(n_R+λ) − G²/(n+λ)`.
     fn best_split(&self, f: usize, nb: usize, bins: &Bins, p: &TreeParams) -> Option<(usize, u8)> {
         let (gt, ct) = self.totals(nb);
-        let parent = gt * gt / (ct as f64 + p.lambda);
-        let mut best: Option<(f64, usize, u8)> = None;
+        let ct = ct as f64;
+        let parent = gt * gt / (ct + p.lambda);
+        let min_leaf = p.min_leaf as f64;
+        let (mut best_gain, mut best) = (1e-12f64, None);
         for j in 0..f {
-            let (mut gl, mut cl) = (0.0f64, 0u64);
+            let (mut gl, mut cl) = (0.0f64, 0.0f64);
             let nbins = bins.edges[j].len(); // splits after bins 0..nbins-1
-            for b in 0..nbins {
-                gl += self.g[j * nb + b];
-                cl += self.c[j * nb + b] as u64;
-                let cr = ct - cl;
-                if cl < p.min_leaf as u64 {
+            for (b, e) in self.gc[j * nb..j * nb + nbins].iter().enumerate() {
+                if e[1] < 0.5 {
+                    // An empty bin: the same split as the previous one.
                     continue;
                 }
-                if cr < p.min_leaf as u64 {
+                gl += e[0] as f64;
+                cl += e[1] as f64;
+                let cr = ct - cl;
+                if cl < min_leaf {
+                    continue;
+                }
+                if cr < min_leaf {
                     break;
                 }
                 let gr = gt - gl;
-                let gain =
-                    gl * gl / (cl as f64 + p.lambda) + gr * gr / (cr as f64 + p.lambda) - parent;
-                if gain > 1e-12 && best.is_none_or(|(bg, _, _)| gain > bg) {
-                    best = Some((gain, j, b as u8));
+                let gain = gl * gl / (cl + p.lambda) + gr * gr / (cr + p.lambda) - parent;
+                if gain > best_gain {
+                    best_gain = gain;
+                    best = Some((j, b as u8));
                 }
             }
         }
-        best.map(|(_, j, b)| (j, b))
+        best
     }
 }

@@ -1,0 +1,249 @@
+//! Trainer, model directories and classical regressors on small synthetic problems.
+
+use railforce::features::{DataSet, LabelAt, NoiseProtocol, Run, Split};
+use railforce::learn::classical::{Classical, ClassicalParams};
+use railforce::learn::evaluate::{EvalPart, evaluate};
+use railforce::learn::metrics::metrics;
+use railforce::learn::model::{Model, ModelKind};
+use railforce::learn::train::{TrainOptions, train};
+use railforce::learn::windows::DataSpec;
+use std::path::PathBuf;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("railforce-learn-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Three inputs and a target that depends nonlinearly on lagged inputs.
+fn synthetic(runs: usize, rows: usize) -> DataSet {
+    let names: Vec<String> = ["a", "b", "c", "w1l_force_y", "time_s"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let runs = (0..runs)
+        .map(|r| {
+            let ph = r as f64 * 0.7;
+            let a: Vec<f64> = (0..rows)
+                .map(|t| (0.05 * t as f64 + ph).sin() + 0.3 * (0.31 * t as f64).sin())
+                .collect();
+            let b: Vec<f64> = (0..rows)
+                .map(|t| (0.021 * t as f64 + 2.0 * ph).cos())
+                .collect();
+            let c: Vec<f64> = (0..rows)
+                .map(|t| (0.13 * t as f64 + ph).sin() * (0.007 * t as f64).cos())
+                .collect();
+            let y: Vec<f64> = (0..rows)
+                .map(|t| {
+                    let l = t.saturating_sub(3);
+                    1000.0 * (a[t] * b[l] + 0.5 * (2.0 * c[t.saturating_sub(1)]).tanh())
+                })
+                .collect();
+            let time: Vec<f64> = (0..rows).map(|t| t as f64 / 200.0).collect();
+            Run {
+                condition: format!("cond{r}"),
+                seed: 1,
+                columns: vec![a, b, c, y, time],
+            }
+        })
+        .collect();
+    DataSet {
+        dir: PathBuf::from("synthetic"),
+        names,
+        runs,
+    }
+}
+
+fn spec() -> DataSpec {
+    DataSpec {
+        channels: vec!["a".into(), "b".into(), "c".into()],
+        targets: vec!["w1l_force_y".into()],
+        window: 8,
+        label_at: LabelAt::Last,
+        stride: 1,
+        split: Split::default(),
+        noise: NoiseProtocol::Clean,
+    }
+}
+
+fn quick(epochs: usize) -> TrainOptions {
+    TrainOptions {
+        epochs,
+        patience: 1000,
+        batch: 32,
+        seed: 3,
+        ..TrainOptions::default()
+    }
+}
+
+#[test]
+fn network_overfits_a_tiny_data_set() {
+    let ds = synthetic(1, 300);
+    let out = tmp("overfit");
+    let mut log = Vec::new();
+    let opts = TrainOptions {
+        dropout: 0.0,
+        ..quick(60)
+    };
+    train(&ds, &spec(), ModelKind::CnnBiLstm, &opts, &out, &mut |p| {
+        if let railforce::learn::train::Progress::Epoch(e) = p {
+            log.push(e.train_loss)
+        }
+    })
+    .unwrap();
+    let (first, last) = (log[0], *log.last().unwrap());
+    assert!(last < first / 10.0, "training loss {first} → {last}");
+    assert!(out.join("train_log.jsonl").exists() && out.join("checkpoint.json").exists());
+}
+
+#[test]
+fn saved_models_predict_the_same_after_loading() {
+    let ds = synthetic(2, 400);
+    for kind in [ModelKind::Gru, ModelKind::Gbdt] {
+        let out = tmp(&format!("roundtrip-{}", kind.name()));
+        let mut m = train(&ds, &spec(), kind, &quick(3), &out, &mut |_| {}).unwrap();
+        let mut back = Model::load(&out).unwrap();
+        let a = evaluate(&mut m, &ds, EvalPart::Test).unwrap();
+        let b = evaluate(&mut back, &ds, EvalPart::Test).unwrap();
+        assert_eq!(a.rows, b.rows, "{}", kind.name());
+        assert_eq!(a.metrics, b.metrics);
+    }
+}
+
+#[test]
+fn same_seed_same_weights_and_resume_continues_exactly() {
+    let ds = synthetic(2, 300);
+    let (a, b, c) = (tmp("seed-a"), tmp("seed-b"), tmp("seed-c"));
+    train(
+        &ds,
+        &spec(),
+        ModelKind::CnnBiLstm,
+        &quick(4),
+        &a,
+        &mut |_| {},
+    )
+    .unwrap();
+    train(
+        &ds,
+        &spec(),
+        ModelKind::CnnBiLstm,
+        &quick(4),
+        &b,
+        &mut |_| {},
+    )
+    .unwrap();
+    let wa = std::fs::read(a.join("weights.bin")).unwrap();
+    assert_eq!(wa, std::fs::read(b.join("weights.bin")).unwrap());
+    // Interrupted after 2 epochs, resumed to 4: the same weights as 4 epochs in one go.
+    train(
+        &ds,
+        &spec(),
+        ModelKind::CnnBiLstm,
+        &quick(2),
+        &c,
+        &mut |_| {},
+    )
+    .unwrap();
+    let resumed = TrainOptions {
+        resume: true,
+        ..quick(4)
+    };
+    train(
+        &ds,
+        &spec(),
+        ModelKind::CnnBiLstm,
+        &resumed,
+        &c,
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(wa, std::fs::read(c.join("weights.bin")).unwrap());
+    let other = TrainOptions {
+        seed: 4,
+        ..quick(4)
+    };
+    train(&ds, &spec(), ModelKind::CnnBiLstm, &other, &b, &mut |_| {}).unwrap();
+    assert_ne!(wa, std::fs::read(b.join("weights.bin")).unwrap());
+    // A checkpoint of other settings is refused, not silently mixed.
+    let wrong = TrainOptions {
+        resume: true,
+        batch: 16,
+        ..quick(5)
+    };
+    let err = train(&ds, &spec(), ModelKind::CnnBiLstm, &wrong, &c, &mut |_| {})
+        .err()
+        .unwrap();
+    assert!(err.to_string().contains("fingerprint"), "{err}");
+}
+
+#[test]
+fn missing_noisy_columns_are_named() {
+    let ds = synthetic(1, 200);
+    let s = DataSpec {
+        noise: NoiseProtocol::Matched,
+        ..spec()
+    };
+    let err = train(
+        &ds,
+        &s,
+        ModelKind::Tree,
+        &quick(1),
+        &tmp("noisy"),
+        &mut |_| {},
+    )
+    .err()
+    .unwrap();
+    assert!(err.to_string().contains("a_noisy"), "{err}");
+}
+
+/// y = sin(2x₀)·x₁ + x₂² on 8 features, 3 of them informative.
+fn regression(n: usize, seed: u64) -> (Vec<f32>, Vec<f32>) {
+    let f = 8;
+    let mut s = seed;
+    let mut u = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 33) as f64 / (1u64 << 31) as f64) * 2.0 - 1.0
+    };
+    let x: Vec<f32> = (0..n * f).map(|_| (u() * 1.5) as f32).collect();
+    let y = (0..n)
+        .map(|r| {
+            let v = &x[r * f..];
+            (2.0 * v[0]).sin() * v[1] + v[2] * v[2] - 0.75
+        })
+        .collect();
+    (x, y)
+}
+
+#[test]
+fn classical_models_learn_a_nonlinear_function() {
+    let (x, y) = regression(3000, 1);
+    let (xt, yt) = regression(1000, 2);
+    let stats = railforce::features::ZScore {
+        names: vec!["y".into()],
+        mean: vec![0.0],
+        std: vec![1000.0],
+    };
+    for (params, bound) in [
+        (ClassicalParams::gbdt(), 0.75),
+        (ClassicalParams::xgboost(), 0.9),
+        // One tree is piecewise constant in 8 dimensions: about 0.5 on this problem.
+        (ClassicalParams::tree(), 0.4),
+        (ClassicalParams::svr(), 0.8),
+    ] {
+        let m = Classical::fit(params, &x, 8, &y, 1, &mut |_, _| {});
+        let p = m.predict(&xt, 1000);
+        let r2 = metrics(&yt, &p, &stats)[0].r2;
+        assert!(r2 > bound, "{params:?}: test R² {r2:.3} ≤ {bound}");
+        // Predicting the mean scores R² ≈ 0: every model beats it by a wide margin.
+        let again = Classical::fit(params, &x, 8, &y, 1, &mut |_, _| {});
+        assert_eq!(m, again, "deterministic fit");
+        assert_eq!(
+            Classical::from_bytes(&m.to_bytes()).unwrap(),
+            m,
+            "round trip"
+        );
+    }
+}
