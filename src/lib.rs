@@ -14,6 +14,7 @@ pub mod dataset;
 pub mod dsp;
 pub mod error;
 pub mod features;
+pub mod identify;
 pub mod io;
 pub mod learn;
 pub mod plan;

@@ -139,3 +139,61 @@ pub fn classical_fit(
     let sse: f32 = yt.iter().zip(&p).map(|(a, b)| (a - b).powi(2)).sum();
     (secs, (1.0 - sse / sst) as f64)
 }
+
+/// Streaming latency of the CNN-BiLSTM, µs per new sample ([`crate::identify::Streamer::push`]:
+/// standardise, shift the window, one forward pass), over `samples` pushes.
+pub fn streaming_latency_us(samples: usize) -> f64 {
+    use crate::features::{LabelAt, NoiseProtocol, Split, ZScore};
+    use crate::learn::model::{Engine, Model, ModelKind, ModelMeta};
+    use crate::learn::windows::DataSpec;
+    let channels: Vec<String> = crate::sim::output::PAPER_CHANNELS
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
+    let config = NetConfig {
+        architecture: Architecture::CnnBiLstm,
+        window: 20,
+        channels: 21,
+        outputs: 2,
+        dropout: 0.2,
+        seed: 1,
+    };
+    let net = Network::new(config.clone());
+    let stats = |names: Vec<String>| ZScore {
+        mean: vec![0.0; names.len()],
+        std: vec![1.0; names.len()],
+        names,
+    };
+    let mut model = Model {
+        meta: ModelMeta {
+            kind: ModelKind::CnnBiLstm,
+            data: DataSpec {
+                channels: channels.clone(),
+                targets: vec!["w1l_force_y".into(), "w1l_force_z".into()],
+                window: 20,
+                label_at: LabelAt::Last,
+                stride: 1,
+                split: Split::default(),
+                noise: NoiseProtocol::Clean,
+            },
+            input_stats: stats(channels),
+            target_stats: stats(vec!["w1l_force_y".into(), "w1l_force_z".into()]),
+            net: Some(config),
+            slots: Some(net.params.slots.clone()),
+            data_identity: serde_json::Value::Null,
+            training: serde_json::Value::Null,
+            version: String::new(),
+        },
+        engine: Engine::Net(Box::new(net)),
+    };
+    let mut st = crate::identify::Streamer::new(&mut model);
+    let row: Vec<f64> = (0..21).map(|k| (k as f64 * 0.3).sin()).collect();
+    for i in 0..20 {
+        st.push(i as f64 * 0.005, &row);
+    }
+    let t0 = Instant::now();
+    for i in 0..samples {
+        std::hint::black_box(st.push((20 + i) as f64 * 0.005, &row));
+    }
+    t0.elapsed().as_secs_f64() * 1e6 / samples as f64
+}

@@ -83,6 +83,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
                     b.train_windows_per_s / gf
                 );
             }
+            let lat = learn::streaming_latency_us(5000);
+            println!(
+                "streaming identification (cnn-bilstm, FL + FQ): {lat:.1} µs per new sample, {:.0}× inside the 5 ms sampling interval",
+                5000.0 / lat
+            );
             if rows > 0 {
                 use railforce::learn::classical::ClassicalParams;
                 for (name, p, reference) in [

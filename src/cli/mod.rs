@@ -4,6 +4,7 @@
 mod bench;
 mod contact;
 mod generate;
+mod identify;
 mod select;
 mod simulate;
 mod track;
@@ -74,6 +75,14 @@ enum Command {
     /// Score a trained model on a data set: MSE and R² on standardised targets with
     /// Var(y_test), RMSE and MAE in kN, predictions to CSV.
     Evaluate(train::EvaluateArgs),
+    /// Identify wheel–rail forces from a sensor recording with a trained model, with safety
+    /// indices (|Y|/Q, wheel unloading ΔQ/Q̄, wheelset lateral force) and an exceedance report.
+    ///
+    /// The input (CSV, NPZ or Parquet with a `time_s` column) is checked first: every channel
+    /// the model needs, 200 Hz without gaps (`--resample` interpolates), no NaN — the error
+    /// names the column and row. `--input -` streams CSV lines from standard input and writes
+    /// each estimate as soon as its window is complete.
+    Identify(identify::IdentifyArgs),
     /// Check railforce against reference solutions (`validate contact`, `validate dynamics`).
     Validate(validate::ValidateArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
@@ -92,6 +101,7 @@ pub fn main() -> ExitCode {
         Command::Select(args) => select::run(args),
         Command::Train(args) => train::run(args),
         Command::Evaluate(args) => train::run_evaluate(args),
+        Command::Identify(args) => identify::run(args),
         Command::Validate(args) => validate::run(args),
         Command::Bench(args) => bench::run(args),
     };

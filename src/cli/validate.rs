@@ -14,6 +14,25 @@ pub struct ValidateArgs {
 
 #[derive(Debug, Subcommand)]
 enum What {
+    /// Closed loop: simulate every condition of a plan with a seed never used in training,
+    /// identify the forces with the model and compare with the simulator's truth (R², RMSE,
+    /// peak error, safety verdicts). Writes MODEL/closed_loop_seedN.json.
+    Identify {
+        /// Model directory.
+        #[arg(long)]
+        model: PathBuf,
+        /// Plan whose conditions are simulated afresh.
+        #[arg(long)]
+        plan: PathBuf,
+        /// Seed (default: the largest training seed + 1000).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Simulations in parallel.
+        #[arg(long, default_value_t = 2)]
+        jobs: usize,
+        #[command(flatten)]
+        limits: super::identify::LimitArgs,
+    },
     /// Contact model against CONTACT: Manchester benchmark A-2.2 (contact position, angle,
     /// roll) and the tractcurv creep curve (Polach vs Kalker exact, FASTSIM vs FASTSIM).
     ///
@@ -44,6 +63,13 @@ enum What {
 
 pub fn run(args: ValidateArgs) -> Result<()> {
     match args.what {
+        What::Identify {
+            model,
+            plan,
+            seed,
+            jobs,
+            limits,
+        } => super::identify::validate(&model, &plan, seed, jobs, &limits.limits()),
         What::Contact { reference_dir } => contact(&reference_dir),
         What::Dynamics {
             vehicle,

@@ -6,7 +6,8 @@ pub mod samples;
 pub mod wrapper;
 
 pub use samples::{
-    Block, DataSet, LabelAt, NoiseProtocol, Part, Run, Samples, Split, Window, ZScore,
+    Block, DataSet, LabelAt, NoiseProtocol, Part, Run, Samples, Split, Window, ZScore, read_csv,
+    read_table,
 };
 
 use crate::error::{Error, Result};

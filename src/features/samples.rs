@@ -59,16 +59,7 @@ impl DataSet {
         let mut runs = Vec::new();
         for r in runs_meta {
             let file = dir.join(r["file"].as_str().unwrap_or_default());
-            let bytes = std::fs::read(&file).map_err(|e| Error::io(&file, e))?;
-            let ext = file.extension().map(|e| e.to_string_lossy().into_owned());
-            let cols: Vec<(String, Vec<f64>)> = match ext.as_deref() {
-                Some("npz") => npz::read_npz(&bytes).map_err(|e| Error::io(&file, e))?,
-                Some("parquet") => parquet_file::read_parquet(bytes).map_err(|e| Error::Parse {
-                    file: file.clone(),
-                    message: e.to_string(),
-                })?,
-                _ => read_csv(&bytes, &file)?,
-            };
+            let cols = read_table(&file)?;
             let these: Vec<String> = cols.iter().map(|(n, _)| n.clone()).collect();
             match &names {
                 None => names = Some(these),
@@ -111,7 +102,22 @@ impl DataSet {
     }
 }
 
-fn read_csv(bytes: &[u8], file: &Path) -> Result<Vec<(String, Vec<f64>)>> {
+/// Reads a table of named f64 columns from an `.npz`, `.parquet` or CSV file (by extension).
+pub fn read_table(file: &Path) -> Result<Vec<(String, Vec<f64>)>> {
+    let bytes = std::fs::read(file).map_err(|e| Error::io(file, e))?;
+    let ext = file.extension().map(|e| e.to_string_lossy().into_owned());
+    match ext.as_deref() {
+        Some("npz") => npz::read_npz(&bytes).map_err(|e| Error::io(file, e)),
+        Some("parquet") => parquet_file::read_parquet(bytes).map_err(|e| Error::Parse {
+            file: file.to_path_buf(),
+            message: e.to_string(),
+        }),
+        _ => read_csv(&bytes, file),
+    }
+}
+
+/// Parses CSV text with a header of column names (as [`read_table`] does for `.csv`).
+pub fn read_csv(bytes: &[u8], file: &Path) -> Result<Vec<(String, Vec<f64>)>> {
     let text = String::from_utf8_lossy(bytes);
     let mut lines = text.lines();
     let header: Vec<String> = lines

@@ -1,0 +1,271 @@
+//! `railforce identify` and `railforce validate identify`: forces and safety indices from
+//! sensor recordings with a trained model.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use railforce::identify::safety::{IndexReport, Limits, indices};
+use railforce::identify::{SensorTable, Streamer, check, identify};
+use railforce::learn::model::Model;
+use std::fmt::Write as _;
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+
+/// Limits of the safety indices (defaults: commonly quoted Chinese values, secondary sources).
+#[derive(Debug, Args, Clone)]
+pub struct LimitArgs {
+    /// Derailment coefficient |Y|/Q limit (1.2 allowable, 1.0 preferred).
+    #[arg(long, default_value_t = 1.2)]
+    pub limit_yq: f64,
+    /// Wheel unloading ΔQ/Q̄ limit (0.65 allowable, 0.60 preferred).
+    #[arg(long, default_value_t = 0.65)]
+    pub limit_unloading: f64,
+    /// Static wheel load Q̄, kN (C80: 25 t axle load → 122.6 kN); H's limit 0.85·(10 + P_st/3)
+    /// follows from it.
+    #[arg(long, default_value_t = 122.625)]
+    pub static_wheel_load_kn: f64,
+}
+
+impl LimitArgs {
+    pub fn limits(&self) -> Limits {
+        Limits {
+            y_over_q: self.limit_yq,
+            unloading: self.limit_unloading,
+            static_wheel_load_kn: self.static_wheel_load_kn,
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub struct IdentifyArgs {
+    /// Model directory written by `railforce train`.
+    #[arg(long)]
+    model: PathBuf,
+    /// Sensor file (CSV, NPZ or Parquet, named channels and a time column `time_s`), or `-`
+    /// to stream CSV lines from standard input (header first).
+    #[arg(long)]
+    input: PathBuf,
+    /// Output CSV of identified forces (N) and safety indices; `-` for standard output.
+    #[arg(long, default_value = "-")]
+    out: PathBuf,
+    /// Interpolate the input linearly onto 200 Hz instead of refusing another rate.
+    #[arg(long)]
+    resample: bool,
+    #[command(flatten)]
+    limits: LimitArgs,
+}
+
+pub fn run(args: IdentifyArgs) -> Result<()> {
+    let mut model = Model::load(&args.model)?;
+    if args.input.as_os_str() == "-" {
+        return stream(&mut model, &args.out);
+    }
+    let table = SensorTable::read(&args.input)?;
+    let input = check(&table, &model, args.resample)?;
+    let t0 = std::time::Instant::now();
+    let id = identify(&mut model, &input);
+    let secs = t0.elapsed().as_secs_f64();
+    let reports = indices(&id, &args.limits.limits());
+    let mut s = String::from("time_s");
+    for t in &id.targets {
+        let _ = write!(s, ",{t}_N");
+    }
+    for r in &reports {
+        let _ = write!(s, ",{}", r.name.replace(' ', "_"));
+    }
+    s.push('\n');
+    for (i, t) in id.time.iter().enumerate() {
+        let _ = write!(s, "{t:.3}");
+        for v in &id.values[i] {
+            let _ = write!(s, ",{v:.1}");
+        }
+        for r in &reports {
+            let _ = write!(s, ",{:.4}", r.series[i]);
+        }
+        s.push('\n');
+    }
+    if args.out.as_os_str() == "-" {
+        std::io::stdout().write_all(s.as_bytes())?;
+    } else {
+        railforce::io::write_atomic(&args.out, |w| w.write_all(s.as_bytes()))?;
+        let json = serde_json::to_string_pretty(&reports)?;
+        let sp = args.out.with_extension("safety.json");
+        railforce::io::write_atomic(&sp, |w| w.write_all(json.as_bytes()))?;
+        eprintln!(
+            "identified {} estimates of {} from {} ({} channels: {}) in {:.3} s; wrote {} and {}",
+            id.time.len(),
+            id.targets.join(", "),
+            args.input.display(),
+            input.used.len(),
+            if input.used.iter().any(|u| u.ends_with("_noisy")) {
+                "the _noisy copies"
+            } else {
+                "clean names"
+            },
+            secs,
+            args.out.display(),
+            sp.display()
+        );
+    }
+    print_safety(&reports);
+    Ok(())
+}
+
+/// Prints the exceedance report to standard error.
+pub fn print_safety(reports: &[IndexReport]) {
+    if reports.is_empty() {
+        eprintln!(
+            "safety: no index available (Y/Q needs Y and Q of one wheel: train with --target both)"
+        );
+    }
+    for r in reports {
+        let verdict = if r.exceedances.is_empty() {
+            "within limit"
+        } else {
+            "EXCEEDED"
+        };
+        eprintln!(
+            "safety {:<22} max {:>8.3} at {:>8.3} s, limit {:.3} (secondary-source value): {verdict}",
+            r.name, r.max, r.max_time_s, r.limit
+        );
+        for (a, b, peak) in &r.exceedances {
+            eprintln!(
+                "    above the limit from {a:.3} s to {b:.3} s ({:.0} ms), peak {peak:.3}",
+                (b - a) * 1000.0 + 5.0
+            );
+        }
+    }
+}
+
+/// Streams CSV lines from standard input; writes each estimate as soon as its window is full.
+fn stream(model: &mut Model, out: &Path) -> Result<()> {
+    let stdin = std::io::stdin();
+    let mut lines = stdin.lock().lines();
+    let header = lines
+        .next()
+        .context("empty input: expected a CSV header")??;
+    let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
+    let time_k = names
+        .iter()
+        .position(|n| railforce::identify::TIME_COLUMNS.contains(&n.as_str()))
+        .context("stdin: no time column (time_s, time or t)")?;
+    let spec = model.meta.data.clone();
+    let pick: Vec<usize> = spec
+        .channels
+        .iter()
+        .map(|c| {
+            let noisy = spec.noise.column(c, railforce::features::Part::Test);
+            names
+                .iter()
+                .position(|n| *n == noisy)
+                .or_else(|| names.iter().position(|n| n == c))
+                .with_context(|| format!("stdin: missing channel {c} required by the model"))
+        })
+        .collect::<Result<_>>()?;
+    let mut w: Box<dyn Write> = if out.as_os_str() == "-" {
+        Box::new(std::io::stdout().lock())
+    } else {
+        Box::new(std::io::BufWriter::new(std::fs::File::create(out)?))
+    };
+    let mut head = String::from("time_s");
+    for t in &spec.targets {
+        let _ = write!(head, ",{t}_N");
+    }
+    writeln!(w, "{head}")?;
+    let mut st = Streamer::new(model);
+    let mut values = vec![0.0; pick.len()];
+    let mut last_t: Option<f64> = None;
+    for (row, line) in lines.enumerate() {
+        let line = line?;
+        let fields: Vec<&str> = line.split(',').collect();
+        let num = |k: usize, name: &str| -> Result<f64> {
+            let v: f64 = fields
+                .get(k)
+                .and_then(|s| s.trim().parse().ok())
+                .with_context(|| format!("stdin row {}: column {name} is not a number", row + 1))?;
+            if !v.is_finite() {
+                bail!("stdin row {}: column {name} is {v}", row + 1);
+            }
+            Ok(v)
+        };
+        let t = num(time_k, "time")?;
+        if let Some(p) = last_t
+            && ((t - p) - 0.005).abs() > 5e-5
+        {
+            bail!(
+                "stdin rows {}–{}: step {:.6} s; streaming needs 200 Hz without gaps",
+                row,
+                row + 1,
+                t - p
+            );
+        }
+        last_t = Some(t);
+        for (v, &k) in values.iter_mut().zip(&pick) {
+            *v = num(k, &names[k])?;
+        }
+        if let Some((tl, f)) = st.push(t, &values) {
+            let mut s = format!("{tl:.3}");
+            for v in f {
+                let _ = write!(s, ",{v:.1}");
+            }
+            writeln!(w, "{s}")?;
+            w.flush()?;
+        }
+    }
+    Ok(())
+}
+
+/// `validate identify`: closed loop on fresh simulations.
+pub fn validate(
+    model_dir: &Path,
+    plan: &Path,
+    seed: Option<u64>,
+    jobs: usize,
+    limits: &Limits,
+) -> Result<()> {
+    let mut model = Model::load(model_dir)?;
+    let plan = railforce::plan::Plan::load(plan)?;
+    let seed = seed.unwrap_or_else(|| railforce::identify::closed_loop::fresh_seed(&model));
+    let work = model_dir.join(format!("closed_loop_seed{seed}"));
+    eprintln!(
+        "simulating {} condition(s) of {} with seed {seed} into {} …",
+        plan.conditions.len(),
+        plan.name,
+        work.display()
+    );
+    let runs =
+        railforce::identify::closed_loop::validate(&mut model, &plan, seed, &work, jobs, limits)?;
+    println!(
+        "{:<22} {:<12} {:>8} {:>9} {:>12}",
+        "condition", "target", "R²", "RMSE kN", "peak err kN"
+    );
+    let mut agree = true;
+    for r in &runs {
+        for t in &r.targets {
+            println!(
+                "{:<22} {:<12} {:>8.3} {:>9.2} {:>12.2}",
+                r.condition, t.target, t.r2, t.rmse_kn, t.peak_error_kn
+            );
+        }
+        for (name, tmax, imax, ok) in &r.safety {
+            agree &= ok;
+            println!(
+                "{:<22}   {name}: true max {tmax:.3}, identified max {imax:.3}, verdicts {}",
+                r.condition,
+                if *ok { "agree" } else { "DISAGREE" }
+            );
+        }
+    }
+    let json = serde_json::to_string_pretty(&runs)?;
+    let p = model_dir.join(format!("closed_loop_seed{seed}.json"));
+    railforce::io::write_atomic(&p, |w| w.write_all(json.as_bytes()))?;
+    println!(
+        "safety verdicts {}; report {}",
+        if agree {
+            "all agree"
+        } else {
+            "differ somewhere"
+        },
+        p.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,301 @@
+//! Identification of wheel–rail forces from sensor recordings with a trained model: the input
+//! is checked before any work (channels, rate, gaps, NaN), standardised with the model's own
+//! statistics, windowed like training, and turned into force time series; [`safety`] derives
+//! Y/Q, wheel unloading and wheelset lateral force with an exceedance report. [`Streamer`]
+//! does the same one sample at a time.
+
+pub mod closed_loop;
+pub mod safety;
+
+use crate::error::{Error, Result};
+use crate::features::{LabelAt, Part};
+use crate::learn::model::Model;
+use crate::learn::windows::label_offset;
+use std::path::Path;
+
+/// Sampling rate the models are trained at, Hz.
+pub const RATE_HZ: f64 = 200.0;
+
+/// Names accepted for the time column.
+pub const TIME_COLUMNS: [&str; 3] = ["time_s", "time", "t"];
+
+/// A sensor recording: named columns and a time column.
+#[derive(Debug, Clone)]
+pub struct SensorTable {
+    /// Where it came from (for messages).
+    pub source: String,
+    /// Times, s.
+    pub time: Vec<f64>,
+    /// Named columns.
+    pub columns: Vec<(String, Vec<f64>)>,
+}
+
+impl SensorTable {
+    /// Reads a CSV, NPZ or Parquet file with a time column.
+    pub fn read(path: &Path) -> Result<Self> {
+        let cols = crate::features::read_table(path)?;
+        Self::from_columns(path.display().to_string(), cols)
+    }
+
+    /// Builds a table from columns, taking out the time column.
+    pub fn from_columns(source: String, mut cols: Vec<(String, Vec<f64>)>) -> Result<Self> {
+        let Some(k) = cols
+            .iter()
+            .position(|(n, _)| TIME_COLUMNS.contains(&n.as_str()))
+        else {
+            return Err(Error::Domain(format!(
+                "{source}: no time column (expected one of {})",
+                TIME_COLUMNS.join(", ")
+            )));
+        };
+        let (_, time) = cols.remove(k);
+        Ok(SensorTable {
+            source,
+            time,
+            columns: cols,
+        })
+    }
+
+    fn column(&self, name: &str) -> Option<&[f64]> {
+        self.columns
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_slice())
+    }
+}
+
+/// The model inputs found in a table, in model order, validated.
+#[derive(Debug, Clone)]
+pub struct CheckedInput {
+    /// Column names used (the model's channel or its `_noisy` copy).
+    pub used: Vec<String>,
+    /// Times, s (200 Hz).
+    pub time: Vec<f64>,
+    /// Columns in model order.
+    pub columns: Vec<Vec<f64>>,
+}
+
+/// Checks a table against a model: every channel present (the `_noisy` copy where the model's
+/// test inputs are noisy and the table has one), a 200 Hz time base without gaps (or resampled
+/// linearly onto 200 Hz when `resample`), no NaN or infinity. Errors name the column and row
+/// (rows count from 1 after the header).
+pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<CheckedInput> {
+    let spec = &model.meta.data;
+    let mut used = Vec::new();
+    let mut missing = Vec::new();
+    for c in &spec.channels {
+        let preferred = spec.noise.column(c, Part::Test);
+        if table.column(&preferred).is_some() {
+            used.push(preferred);
+        } else if table.column(c).is_some() {
+            used.push(c.clone());
+        } else {
+            missing.push(c.clone());
+        }
+    }
+    if !missing.is_empty() {
+        return Err(Error::Domain(format!(
+            "{}: missing channel(s) {} required by the model",
+            table.source,
+            missing.join(", ")
+        )));
+    }
+    let t = &table.time;
+    if t.len() < spec.window {
+        return Err(Error::Domain(format!(
+            "{}: {} rows, fewer than one window ({} steps)",
+            table.source,
+            t.len(),
+            spec.window
+        )));
+    }
+    let mut columns: Vec<Vec<f64>> = Vec::new();
+    for name in &used {
+        let v = table.column(name).expect("checked above");
+        if let Some(r) = v.iter().position(|x| !x.is_finite()) {
+            return Err(Error::Domain(format!(
+                "{}: column {name}, row {}: value {} is not a finite number",
+                table.source,
+                r + 1,
+                v[r]
+            )));
+        }
+        columns.push(v.to_vec());
+    }
+    if let Some(r) = t.iter().position(|x| !x.is_finite()) {
+        return Err(Error::Domain(format!(
+            "{}: time column, row {}: not a finite number",
+            table.source,
+            r + 1
+        )));
+    }
+    let dt = 1.0 / RATE_HZ;
+    let bad = t
+        .windows(2)
+        .position(|w| ((w[1] - w[0]) - dt).abs() > 0.01 * dt);
+    match bad {
+        None => Ok(CheckedInput {
+            used,
+            time: t.clone(),
+            columns,
+        }),
+        Some(r) if !resample => {
+            let step = t[r + 1] - t[r];
+            let rate = if step > 0.0 {
+                1.0 / step
+            } else {
+                f64::INFINITY
+            };
+            Err(Error::Domain(format!(
+                "{}: time column, rows {}–{}: step {:.6} s ({:.1} Hz); the model needs {RATE_HZ} Hz without gaps (use --resample to interpolate onto 200 Hz)",
+                table.source,
+                r + 1,
+                r + 2,
+                step,
+                rate
+            )))
+        }
+        Some(_) => {
+            if let Some(r) = t.windows(2).position(|w| w[1] <= w[0]) {
+                return Err(Error::Domain(format!(
+                    "{}: time column, row {}: time does not increase; cannot resample",
+                    table.source,
+                    r + 2
+                )));
+            }
+            let n = ((t[t.len() - 1] - t[0]) / dt).floor() as usize + 1;
+            let new_t: Vec<f64> = (0..n).map(|i| t[0] + i as f64 * dt).collect();
+            let columns = columns.iter().map(|c| interpolate(t, c, &new_t)).collect();
+            Ok(CheckedInput {
+                used,
+                time: new_t,
+                columns,
+            })
+        }
+    }
+}
+
+/// Linear interpolation of `(t, v)` at `at` (ascending, inside the range).
+fn interpolate(t: &[f64], v: &[f64], at: &[f64]) -> Vec<f64> {
+    let mut k = 0;
+    at.iter()
+        .map(|&x| {
+            while k + 2 < t.len() && t[k + 1] < x {
+                k += 1;
+            }
+            let (t0, t1) = (t[k], t[k + 1]);
+            let w = ((x - t0) / (t1 - t0)).clamp(0.0, 1.0);
+            v[k] + w * (v[k + 1] - v[k])
+        })
+        .collect()
+}
+
+/// Identified forces: the label time and one series per model target, in N.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Identified {
+    /// Target names (label channels).
+    pub targets: Vec<String>,
+    /// Time of each estimate, s (the label step of its window).
+    pub time: Vec<f64>,
+    /// Estimates `[n][targets]`, N.
+    pub values: Vec<Vec<f64>>,
+}
+
+/// Identifies forces over a whole checked recording (one estimate per complete window).
+pub fn identify(model: &mut Model, input: &CheckedInput) -> Identified {
+    let spec = model.meta.data.clone();
+    let (w, c) = (spec.window, spec.channels.len());
+    let n = input.time.len();
+    let z = &model.meta.input_stats;
+    let mut rows = vec![0.0f32; n * c];
+    for (k, col) in input.columns.iter().enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            rows[i * c + k] = z.apply(k, *v) as f32;
+        }
+    }
+    let count = n + 1 - w;
+    let mut x = Vec::with_capacity(count.min(4096) * w * c);
+    let mut out = Vec::with_capacity(count * spec.targets.len());
+    for chunk in (0..count).collect::<Vec<_>>().chunks(4096) {
+        x.clear();
+        for &s in chunk {
+            x.extend_from_slice(&rows[s * c..(s + w) * c]);
+        }
+        out.extend(model.predict(&x, chunk.len()));
+    }
+    finish(model, &input.time, out, count)
+}
+
+fn finish(model: &Model, time: &[f64], out: Vec<f32>, count: usize) -> Identified {
+    let spec = &model.meta.data;
+    let o = spec.targets.len();
+    let off = label_offset(spec.window, spec.label_at);
+    let ts = &model.meta.target_stats;
+    Identified {
+        targets: spec.targets.clone(),
+        time: (0..count).map(|s| time[s + off]).collect(),
+        values: (0..count)
+            .map(|s| {
+                (0..o)
+                    .map(|k| out[s * o + k] as f64 * ts.std[k] + ts.mean[k])
+                    .collect()
+            })
+            .collect(),
+    }
+}
+
+/// One-sample-at-a-time identification: keeps the last `window` standardised samples and
+/// answers as soon as a window is complete.
+pub struct Streamer<'a> {
+    model: &'a mut Model,
+    ring: std::collections::VecDeque<f32>,
+    times: std::collections::VecDeque<f64>,
+    x: Vec<f32>,
+}
+
+impl<'a> Streamer<'a> {
+    /// A streamer over `model`.
+    pub fn new(model: &'a mut Model) -> Self {
+        Streamer {
+            model,
+            ring: Default::default(),
+            times: Default::default(),
+            x: Vec::new(),
+        }
+    }
+
+    /// Feeds one sample (`values` in model channel order, physical units); returns the
+    /// estimate `(label time, forces in N)` once a window is complete.
+    pub fn push(&mut self, time: f64, values: &[f64]) -> Option<(f64, Vec<f64>)> {
+        let spec = &self.model.meta.data;
+        let (w, c) = (spec.window, spec.channels.len());
+        let z = &self.model.meta.input_stats;
+        for (k, v) in values.iter().enumerate().take(c) {
+            self.ring.push_back(z.apply(k, *v) as f32);
+        }
+        self.times.push_back(time);
+        while self.times.len() > w {
+            self.times.pop_front();
+            for _ in 0..c {
+                self.ring.pop_front();
+            }
+        }
+        if self.times.len() < w {
+            return None;
+        }
+        self.x.clear();
+        self.x.extend(self.ring.iter());
+        let x = std::mem::take(&mut self.x);
+        let out = self.model.predict(&x, 1);
+        self.x = x;
+        let times: Vec<f64> = self.times.iter().copied().collect();
+        let id = finish(self.model, &times, out, 1);
+        Some((id.time[0], id.values[0].clone()))
+    }
+
+    /// Label position of the model (estimates lag the newest sample by `window − 1 − offset`
+    /// steps for a centre label).
+    pub fn label_at(&self) -> LabelAt {
+        self.model.meta.data.label_at
+    }
+}

@@ -1,0 +1,132 @@
+//! Identification: input checks, agreement with evaluation, streaming equals batch.
+
+use railforce::features::{DataSet, LabelAt, NoiseProtocol, Run, Split};
+use railforce::identify::{SensorTable, Streamer, check, identify};
+use railforce::learn::evaluate::{EvalPart, evaluate};
+use railforce::learn::model::{Model, ModelKind};
+use railforce::learn::train::{TrainOptions, train};
+use railforce::learn::windows::DataSpec;
+use std::path::PathBuf;
+
+fn synthetic(rows: usize) -> DataSet {
+    let names: Vec<String> = ["time_s", "a", "b", "w1l_force_y"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let a: Vec<f64> = (0..rows).map(|t| (0.05 * t as f64).sin()).collect();
+    let b: Vec<f64> = (0..rows).map(|t| (0.021 * t as f64).cos()).collect();
+    let y: Vec<f64> = (0..rows)
+        .map(|t| 1000.0 * a[t] * b[t.saturating_sub(2)])
+        .collect();
+    let time: Vec<f64> = (0..rows).map(|t| t as f64 * 0.005).collect();
+    let run = Run {
+        condition: "c".into(),
+        seed: 1,
+        columns: vec![time, a, b, y],
+    };
+    DataSet {
+        dir: PathBuf::from("synthetic"),
+        names,
+        runs: vec![run],
+    }
+}
+
+fn model(label_at: LabelAt, test: &str) -> (DataSet, Model) {
+    let ds = synthetic(600);
+    let spec = DataSpec {
+        channels: vec!["a".into(), "b".into()],
+        targets: vec!["w1l_force_y".into()],
+        window: 6,
+        label_at,
+        stride: 1,
+        split: Split::default(),
+        noise: NoiseProtocol::Clean,
+    };
+    let out = std::env::temp_dir().join(format!(
+        "railforce-identify-{}-{test}-{label_at:?}",
+        std::process::id()
+    ));
+    let opts = TrainOptions {
+        epochs: 3,
+        batch: 32,
+        ..TrainOptions::default()
+    };
+    let m = train(&ds, &spec, ModelKind::Gru, &opts, &out, &mut |_| {}).unwrap();
+    (ds, m)
+}
+
+fn table(ds: &DataSet) -> SensorTable {
+    let cols = ds
+        .names
+        .iter()
+        .cloned()
+        .zip(ds.runs[0].columns.iter().cloned())
+        .collect();
+    SensorTable::from_columns("test input".into(), cols).unwrap()
+}
+
+#[test]
+fn bad_input_gets_a_clear_error() {
+    let (ds, m) = model(LabelAt::Last, "errors");
+    let good = table(&ds);
+    let mut missing = good.clone();
+    missing.columns.retain(|(n, _)| n != "b");
+    let e = check(&missing, &m, false).unwrap_err().to_string();
+    assert!(e.contains("missing channel(s) b"), "{e}");
+    let mut nan = good.clone();
+    nan.columns[0].1[41] = f64::NAN;
+    let e = check(&nan, &m, false).unwrap_err().to_string();
+    assert!(e.contains("column a, row 42"), "{e}");
+    let mut slow = good.clone();
+    slow.time = (0..slow.time.len()).map(|i| i as f64 * 0.01).collect();
+    let e = check(&slow, &m, false).unwrap_err().to_string();
+    assert!(e.contains("100.0 Hz") && e.contains("--resample"), "{e}");
+    // Resampling a 100 Hz record gives a 200 Hz one of the same span.
+    let r = check(&slow, &m, true).unwrap();
+    assert_eq!(r.time.len(), 2 * slow.time.len() - 1);
+    let mut gap = good.clone();
+    gap.time[300..].iter_mut().for_each(|t| *t += 0.5);
+    let e = check(&gap, &m, false).unwrap_err().to_string();
+    assert!(e.contains("rows 300–301"), "{e}");
+    let e = SensorTable::from_columns("x".into(), vec![("a".into(), vec![1.0])])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no time column"), "{e}");
+}
+
+#[test]
+fn identify_reproduces_the_evaluation_and_streaming_equals_batch() {
+    for label_at in [LabelAt::Last, LabelAt::Centre] {
+        let (ds, mut m) = model(label_at, "agree");
+        let ev = evaluate(&mut m, &ds, EvalPart::All).unwrap();
+        let input = check(&table(&ds), &m, false).unwrap();
+        let id = identify(&mut m, &input);
+        assert_eq!(id.time.len(), ev.rows.len());
+        for (i, row) in ev.rows.iter().enumerate() {
+            assert!((row.2 - id.time[i]).abs() < 1e-9, "label times align");
+            let (truth, pred) = row.3[0];
+            assert!(
+                (pred - id.values[i][0]).abs() < 1e-6 * truth.abs().max(1.0) + 1e-3,
+                "same numbers as evaluate"
+            );
+        }
+        let mut st = Streamer::new(&mut m);
+        let mut streamed = Vec::new();
+        for (i, t) in input.time.iter().enumerate() {
+            let v: Vec<f64> = input.columns.iter().map(|c| c[i]).collect();
+            if let Some(e) = st.push(*t, &v) {
+                streamed.push(e);
+            }
+        }
+        assert_eq!(streamed.len(), id.time.len());
+        for (s, (t, v)) in streamed.iter().enumerate() {
+            assert_eq!(*t, id.time[s]);
+            assert!(
+                (v[0] - id.values[s][0]).abs() <= 1e-6 * v[0].abs().max(1.0),
+                "{} vs {}",
+                v[0],
+                id.values[s][0]
+            );
+        }
+    }
+}
