@@ -3,6 +3,7 @@
 
 mod bench;
 mod contact;
+mod experiment;
 mod generate;
 mod identify;
 mod select;
@@ -83,6 +84,13 @@ enum Command {
     /// names the column and row. `--input -` streams CSV lines from standard input and writes
     /// each estimate as soon as its window is complete.
     Identify(identify::IdentifyArgs),
+    /// Rerun the paper's experiments: model comparison, generalisation over conditions
+    /// (with leave-one-condition-out) and robustness to noise; writes tables (Markdown, CSV),
+    /// SVG figures and index.html with the paper's numbers beside ours.
+    Experiment(experiment::ExperimentArgs),
+    /// The whole chain in a few minutes: simulate three short conditions, train a CNN-BiLSTM
+    /// and GBDT, sweep four SNRs, and write the report (demo/index.html).
+    Demo(experiment::DemoArgs),
     /// Check railforce against reference solutions (`validate contact`, `validate dynamics`).
     Validate(validate::ValidateArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
@@ -102,6 +110,8 @@ pub fn main() -> ExitCode {
         Command::Train(args) => train::run(args),
         Command::Evaluate(args) => train::run_evaluate(args),
         Command::Identify(args) => identify::run(args),
+        Command::Experiment(args) => experiment::run(args),
+        Command::Demo(args) => experiment::demo(args),
         Command::Validate(args) => validate::run(args),
         Command::Bench(args) => bench::run(args),
     };

@@ -1,0 +1,125 @@
+//! `railforce experiment …` and `railforce demo`: the paper's experiments and the one-command
+//! demonstration, as thin shells over `railforce::experiment`.
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use railforce::experiment::{self, ExperimentOptions, Which};
+use railforce::learn::model::ModelKind;
+use railforce::learn::train::TrainOptions;
+use std::path::PathBuf;
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum WhichArg {
+    /// Eight models on one condition at 6 dB (paper Tables 2–3).
+    Comparison,
+    /// One CNN-BiLSTM over all conditions, plus leave-one-condition-out (Tables 4–5).
+    Generalization,
+    /// SNR sweep of GBDT, BiLSTM, CNN and CNN-BiLSTM under both noise protocols (Fig. 8).
+    Robustness,
+    /// All three.
+    All,
+}
+
+#[derive(Debug, Args)]
+pub struct ExperimentArgs {
+    /// Which experiment.
+    #[arg(value_enum)]
+    which: WhichArg,
+    /// Plan of conditions (simulated once, clean; noise is added per SNR).
+    #[arg(long, default_value = "tracks/paper34.plan.toml")]
+    plan: PathBuf,
+    /// Output folder: data/, one folder per experiment, index.html, meta.json.
+    #[arg(long, default_value = "experiments")]
+    out: PathBuf,
+    /// Condition of the comparison and robustness experiments.
+    #[arg(long, default_value = "curve_r400_v60")]
+    condition: String,
+    /// SNR of the comparison and generalisation, dB.
+    #[arg(long, default_value_t = 6.0)]
+    snr_db: f64,
+    /// Epochs at most per network.
+    #[arg(long, default_value_t = 100)]
+    epochs: usize,
+    /// Early-stopping patience.
+    #[arg(long, default_value_t = 10)]
+    patience: usize,
+    /// Training windows drawn per epoch (0: all).
+    #[arg(long, default_value_t = 50_000)]
+    windows_per_epoch: usize,
+    /// Seed of every training.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Simulations in parallel.
+    #[arg(long, default_value_t = 2)]
+    jobs: usize,
+}
+
+fn run_with(which: Which, opts: &ExperimentOptions) -> Result<()> {
+    let t0 = std::time::Instant::now();
+    let index = experiment::run(which, opts, &mut |line| {
+        eprintln!("[{:>6.0} s] {line}", t0.elapsed().as_secs_f64())
+    })?;
+    println!(
+        "report: {} ({:.0} s)",
+        index.display(),
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+pub fn run(args: ExperimentArgs) -> Result<()> {
+    let which = match args.which {
+        WhichArg::Comparison => Which::Comparison,
+        WhichArg::Generalization => Which::Generalization,
+        WhichArg::Robustness => Which::Robustness,
+        WhichArg::All => Which::All,
+    };
+    let mut opts = ExperimentOptions::full(args.plan, args.out);
+    opts.condition = args.condition;
+    opts.snr_db = args.snr_db;
+    opts.jobs = args.jobs;
+    opts.train = TrainOptions {
+        epochs: args.epochs,
+        patience: args.patience,
+        seed: args.seed,
+        windows_per_epoch: (args.windows_per_epoch > 0).then_some(args.windows_per_epoch),
+        ..TrainOptions::default()
+    };
+    run_with(which, &opts)
+}
+
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Output folder of the demo report.
+    #[arg(long, default_value = "demo")]
+    out: PathBuf,
+    /// Plan (three short conditions).
+    #[arg(long, default_value = "tracks/demo.plan.toml")]
+    plan: PathBuf,
+}
+
+/// The demo's settings: three short runs, a CNN-BiLSTM and GBDT, four SNRs.
+pub fn demo_options(plan: PathBuf, out: PathBuf) -> ExperimentOptions {
+    ExperimentOptions {
+        models: vec![ModelKind::CnnBiLstm, ModelKind::Gbdt],
+        robustness_models: vec![ModelKind::Gbdt, ModelKind::CnnBiLstm],
+        snrs: vec![100.0, 20.0, 6.0, 1.0],
+        loco: vec!["curve_r400_v60".into()],
+        train: TrainOptions {
+            epochs: 25,
+            patience: 8,
+            ..TrainOptions::default()
+        },
+        ..ExperimentOptions::full(plan, out)
+    }
+}
+
+pub fn demo(args: DemoArgs) -> Result<()> {
+    if cfg!(debug_assertions) {
+        eprintln!("warning: debug build; `cargo run --release -- demo` is many times faster");
+    }
+    eprintln!(
+        "railforce demo: simulate 3 short conditions, train a CNN-BiLSTM and GBDT, sweep 4 SNRs, write the report"
+    );
+    run_with(Which::All, &demo_options(args.plan, args.out))
+}
