@@ -136,3 +136,18 @@ fn validate_contact_passes_on_the_reference_data() {
     let (ok, _, err) = railforce(&["validate", "contact", "--reference-dir", "/no/such/dir"]);
     assert!(!ok && err.contains("/no/such/dir"), "{err}");
 }
+
+#[test]
+fn learning_commands_explain_bad_input() {
+    let (ok, _, err) = railforce(&["train", "--data", "tracks", "--model", "transformer", "--out", "x"]);
+    assert!(!ok && err.contains("unknown model `transformer`") && err.contains("cnn-bilstm"), "{err}");
+    let missing = tmp("no_model");
+    let (ok, _, err) = railforce(&["identify", "--model", missing.to_str().unwrap(), "--input", "x.csv"]);
+    assert!(!ok && err.contains("model.json"), "{err}");
+    let (ok, out, _) = railforce(&["--help"]);
+    for cmd in ["train", "evaluate", "identify", "experiment", "demo"] {
+        assert!(ok && out.contains(cmd), "{cmd} missing from --help: {out}");
+    }
+    let (ok, out, _) = railforce(&["validate", "identify", "--help"]);
+    assert!(ok && out.contains("never used in training"), "{out}");
+}
