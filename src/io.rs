@@ -34,13 +34,16 @@ where
     })
 }
 
-/// Temporary sibling of `path` used by [`write_atomic`]: `.NAME.tmp-PID`.
+/// Temporary sibling of `path` used by [`write_atomic`]: `.NAME.tmp-PID-N`, N unique within
+/// the process so that two threads writing the same file never share a temporary.
 fn temp_path(path: &Path) -> PathBuf {
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
-    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
+    path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()))
 }
 
 /// Reads a whole text file, naming the path in the error.

@@ -139,10 +139,27 @@ fn validate_contact_passes_on_the_reference_data() {
 
 #[test]
 fn learning_commands_explain_bad_input() {
-    let (ok, _, err) = railforce(&["train", "--data", "tracks", "--model", "transformer", "--out", "x"]);
-    assert!(!ok && err.contains("unknown model `transformer`") && err.contains("cnn-bilstm"), "{err}");
+    let (ok, _, err) = railforce(&[
+        "train",
+        "--data",
+        "tracks",
+        "--model",
+        "transformer",
+        "--out",
+        "x",
+    ]);
+    assert!(
+        !ok && err.contains("unknown model `transformer`") && err.contains("cnn-bilstm"),
+        "{err}"
+    );
     let missing = tmp("no_model");
-    let (ok, _, err) = railforce(&["identify", "--model", missing.to_str().unwrap(), "--input", "x.csv"]);
+    let (ok, _, err) = railforce(&[
+        "identify",
+        "--model",
+        missing.to_str().unwrap(),
+        "--input",
+        "x.csv",
+    ]);
     assert!(!ok && err.contains("model.json"), "{err}");
     let (ok, out, _) = railforce(&["--help"]);
     for cmd in ["train", "evaluate", "identify", "experiment", "demo"] {

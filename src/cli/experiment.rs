@@ -52,6 +52,10 @@ pub struct ExperimentArgs {
     /// Simulations in parallel.
     #[arg(long, default_value_t = 2)]
     jobs: usize,
+    /// Label at the centre step of the window (non-causal, as the paper reads) instead of the
+    /// last (causal, usable on board in real time).
+    #[arg(long)]
+    centre_label: bool,
 }
 
 fn run_with(which: Which, opts: &ExperimentOptions) -> Result<()> {
@@ -78,6 +82,9 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
     opts.condition = args.condition;
     opts.snr_db = args.snr_db;
     opts.jobs = args.jobs;
+    if args.centre_label {
+        opts.label_at = railforce::features::LabelAt::Centre;
+    }
     opts.train = TrainOptions {
         epochs: args.epochs,
         patience: args.patience,

@@ -39,6 +39,10 @@ pub struct DataArgs {
     /// Stride of the training windows (validation and test always use 1).
     #[arg(long, default_value_t = 1)]
     pub stride: usize,
+    /// Label at the centre step of the window (non-causal, as the paper reads) instead of the
+    /// selection's (or the last step).
+    #[arg(long)]
+    pub centre_label: bool,
 }
 
 #[derive(Debug, Args)]
@@ -92,6 +96,11 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
             20,
             LabelAt::Last,
         ),
+    };
+    let label_at = if args.centre_label {
+        LabelAt::Centre
+    } else {
+        label_at
     };
     for c in &mut channels {
         if let Some(base) = c.strip_suffix("_noisy") {

@@ -58,6 +58,8 @@ pub struct ExperimentOptions {
     pub train: TrainOptions,
     /// Simulations in parallel.
     pub jobs: usize,
+    /// Label position (the last step: causal, the default; the centre: as the paper reads).
+    pub label_at: LabelAt,
 }
 
 impl ExperimentOptions {
@@ -84,6 +86,7 @@ impl ExperimentOptions {
                 ..TrainOptions::default()
             },
             jobs: 2,
+            label_at: LabelAt::Last,
         }
     }
 }
@@ -154,12 +157,12 @@ fn subset(ds: &DataSet, conditions: &[String]) -> DataSet {
     }
 }
 
-fn spec(noise: NoiseProtocol, split: Split) -> DataSpec {
+fn spec(label_at: LabelAt, noise: NoiseProtocol, split: Split) -> DataSpec {
     DataSpec {
         channels: PAPER_CHANNELS.iter().map(|c| c.to_string()).collect(),
         targets: vec!["w1l_force_y".into(), "w1l_force_z".into()],
         window: 20,
-        label_at: LabelAt::Last,
+        label_at,
         stride: 1,
         split,
         noise,
@@ -293,10 +296,11 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
         "snr_db": opts.snr_db,
         "condition": opts.condition,
         "training": opts.train,
+        "label_at": format!("{:?}", opts.label_at),
         "railforce_version": env!("CARGO_PKG_VERSION"),
         "wall_seconds": wall,
         "timings": timings,
-        "protocol": "70/15/15 % contiguous blocks per run (or whole conditions held out), z-scores from training blocks, window 20 × 21 channels, label at the last step (causal), FL and FQ as two outputs of one model",
+        "protocol": "70/15/15 % contiguous blocks per run (or whole conditions held out), z-scores from training blocks, window 20 × 21 channels, FL and FQ as two outputs of one model",
     });
     let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");
     crate::io::write_atomic(&opts.out.join("meta.json"), |w| w.write_all(mj.as_bytes()))?;
@@ -310,8 +314,26 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
             opts.train.seed,
             wall
         ),
-        "Protocol: each run cut into contiguous 70/15/15 % train/validation/test blocks before windowing (no window crosses a block), z-scores from the training blocks only, windows of 20 steps × 21 channels, label at the last step (causal), FL (w1l_force_y) and FQ (w1l_force_z) as the two outputs of one model. MSE and R² on standardised targets; Var(y_test) shown beside them. Paper numbers come from another simulator and unknown splits: a bar, not a target to match digit for digit.".into(),
-        format!("Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch; classical models on at most {} windows.", opts.train.lr, opts.train.batch, opts.train.epochs, opts.train.patience, opts.train.windows_per_epoch.map(|w| w.to_string()).unwrap_or("all".into()), opts.train.classical_rows),
+        format!(
+            "Protocol: each run cut into contiguous 70/15/15 % train/validation/test blocks before windowing (no window crosses a block), z-scores from the training blocks only, windows of 20 steps × 21 channels, label at the {} step, FL (w1l_force_y) and FQ (w1l_force_z) as the two outputs of one model. MSE and R² on standardised targets; Var(y_test) shown beside them. Paper numbers come from another simulator and unknown splits: a bar, not a target to match digit for digit.",
+            if opts.label_at == LabelAt::Last {
+                "last (causal)"
+            } else {
+                "centre (non-causal)"
+            }
+        ),
+        format!(
+            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch; classical models on at most {} windows.",
+            opts.train.lr,
+            opts.train.batch,
+            opts.train.epochs,
+            opts.train.patience,
+            opts.train
+                .windows_per_epoch
+                .map(|w| w.to_string())
+                .unwrap_or("all".into()),
+            opts.train.classical_rows
+        ),
     ];
     write_index(
         &opts.out,
@@ -328,7 +350,7 @@ fn comparison(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
         &subset(ds, std::slice::from_ref(&opts.condition)),
         opts.snr_db,
     );
-    let sp = spec(NoiseProtocol::Matched, Split::default());
+    let sp = spec(opts.label_at, NoiseProtocol::Matched, Split::default());
     let dir = opts.out.join("comparison");
     let mut tables: [Table; 2] = std::array::from_fn(|_| {
         Table::new(&[
@@ -494,7 +516,7 @@ fn generalization(ctx: &mut Ctx, ds: &DataSet, conditions: &[String]) -> Result<
     let dir = opts.out.join("generalization");
     let (mut model, secs) = ctx.fit(
         &dsn,
-        &spec(NoiseProtocol::Matched, Split::default()),
+        &spec(opts.label_at, NoiseProtocol::Matched, Split::default()),
         ModelKind::CnnBiLstm,
         &dir.join("models/all_conditions"),
     )?;
@@ -568,6 +590,7 @@ fn generalization(ctx: &mut Ctx, ds: &DataSet, conditions: &[String]) -> Result<
             ));
         }
         let sp = spec(
+            opts.label_at,
             NoiseProtocol::Matched,
             Split::Conditions {
                 val: vec![val.clone()],
@@ -651,7 +674,7 @@ fn robustness(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
             let clean_model = if proto == NoiseProtocol::TrainCleanTestNoisy {
                 let (mut m, _) = ctx.fit(
                     &base,
-                    &spec(NoiseProtocol::Clean, Split::default()),
+                    &spec(opts.label_at, NoiseProtocol::Clean, Split::default()),
                     kind,
                     &dir.join(format!("models/clean_{}", kind.name())),
                 )?;
@@ -668,7 +691,7 @@ fn robustness(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
                     None => {
                         let (mut m, _) = ctx.fit(
                             &dsn,
-                            &spec(NoiseProtocol::Matched, Split::default()),
+                            &spec(opts.label_at, NoiseProtocol::Matched, Split::default()),
                             kind,
                             &dir.join(format!("models/matched_{}_{snr}dB", kind.name())),
                         )?;

@@ -264,11 +264,20 @@ impl<'a> Streamer<'a> {
         }
     }
 
-    /// Feeds one sample (`values` in model channel order, physical units); returns the
-    /// estimate `(label time, forces in N)` once a window is complete.
+    /// Feeds one sample (`values` in model channel order, physical units, one per channel);
+    /// returns the estimate `(label time, forces in N)` once a window is complete.
+    ///
+    /// # Panics
+    /// When `values` does not hold one value per model channel.
     pub fn push(&mut self, time: f64, values: &[f64]) -> Option<(f64, Vec<f64>)> {
         let spec = &self.model.meta.data;
         let (w, c) = (spec.window, spec.channels.len());
+        assert_eq!(
+            values.len(),
+            c,
+            "one value per model channel ({})",
+            spec.channels.join(", ")
+        );
         let z = &self.model.meta.input_stats;
         for (k, v) in values.iter().enumerate().take(c) {
             self.ring.push_back(z.apply(k, *v) as f32);

@@ -55,7 +55,7 @@ impl Booster {
             // Update the predictions from the leaves each row reached (rows are partitioned
             // by leaf, but walking the binned row is just as cheap and simpler).
             for i in 0..n {
-                pred[i] += predict_binned(&tree, &xb[i * f..(i + 1) * f]);
+                pred[i] += tree.predict_binned(&xb[i * f..(i + 1) * f]);
             }
             trees.push(tree);
             progress(t + 1);
@@ -70,21 +70,5 @@ impl Booster {
     /// Prediction for one row of raw features.
     pub fn predict(&self, x: &[f32]) -> f32 {
         self.base + self.trees.iter().map(|t| t.predict(x)).sum::<f32>()
-    }
-}
-
-/// A tree's value for a binned row (`bin ≤ b ⇔ x ≤ edge[b]`).
-fn predict_binned(tree: &Tree, row: &[u8]) -> f32 {
-    let mut i = 0usize;
-    loop {
-        let n = &tree.nodes[i];
-        if n.feature == u32::MAX {
-            return n.value;
-        }
-        i = if row[n.feature as usize] <= n.bin {
-            n.left
-        } else {
-            n.right
-        } as usize;
     }
 }

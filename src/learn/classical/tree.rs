@@ -45,17 +45,25 @@ impl Tree {
     /// Prediction for one row of raw features.
     #[inline]
     pub fn predict(&self, x: &[f32]) -> f32 {
+        self.walk(|n| x[n.feature as usize] <= n.threshold)
+    }
+
+    /// Prediction for one binned row (`bin ≤ b ⇔ x ≤ edge[b]`).
+    #[inline]
+    pub fn predict_binned(&self, row: &[u8]) -> f32 {
+        self.walk(|n| row[n.feature as usize] <= n.bin)
+    }
+
+    /// Leaf value reached from the root, going left where `go_left(split)`.
+    #[inline]
+    fn walk(&self, go_left: impl Fn(&Node) -> bool) -> f32 {
         let mut i = 0usize;
         loop {
             let n = &self.nodes[i];
             if n.feature == u32::MAX {
                 return n.value;
             }
-            i = if x[n.feature as usize] <= n.threshold {
-                n.left as usize
-            } else {
-                n.right as usize
-            };
+            i = if go_left(n) { n.left } else { n.right } as usize;
         }
     }
 
