@@ -125,7 +125,7 @@ pub fn fast_exp(x: f32) -> f32 {
 }
 
 /// `dst = σ(src)` elementwise.
-#[inline]
+#[inline(always)]
 pub fn sigmoid_into(src: &[f32], dst: &mut [f32]) {
     for (d, &s) in dst.iter_mut().zip(src) {
         *d = 1.0 / (1.0 + fast_exp(-s));
@@ -133,7 +133,7 @@ pub fn sigmoid_into(src: &[f32], dst: &mut [f32]) {
 }
 
 /// `dst = tanh(src)` elementwise, as `1 − 2/(e^{2x} + 1)` (absolute error ~1e-7).
-#[inline]
+#[inline(always)]
 pub fn tanh_into(src: &[f32], dst: &mut [f32]) {
     for (d, &s) in dst.iter_mut().zip(src) {
         *d = 1.0 - 2.0 / (fast_exp(2.0 * s) + 1.0);
