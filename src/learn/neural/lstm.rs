@@ -105,17 +105,30 @@ impl BiLstm {
             self.hs[st(0)..st(1)].fill(0.0);
             for s in 0..steps {
                 let t = if dir == 0 { s } else { steps - 1 - s };
-                // z = G[:, t, dir] + h·W_hh, fused with the gates in the cell (rows `ld` apart).
+                // z = G[:, t, dir] + h·W_hh, in place in the gate block (rows `ld` apart).
                 let z0 = t * 2 * g4 + dir * g4;
+                let hprev = &self.hs[st(s)..st(s) + batch * h];
+                gemm_strided(
+                    batch,
+                    h,
+                    g4,
+                    hprev,
+                    h,
+                    false,
+                    wd,
+                    g4,
+                    false,
+                    &mut self.g[z0..],
+                    ld,
+                    1.0,
+                );
                 let a0 = (dir * steps + s) * batch * g4;
                 let t0 = (dir * steps + s) * batch * h;
                 let (c_prev, c_next) = self.cs[st(s)..st(s + 2)].split_at_mut(batch * h);
-                let (h_prev, h_next) = self.hs[st(s)..st(s + 2)].split_at_mut(batch * h);
+                let h_next = &mut self.hs[st(s + 1)..st(s + 2)];
                 let cell = Cell { batch, h, ld };
                 cell.forward(
                     &self.g[z0..],
-                    h_prev,
-                    wd,
                     &mut self.act[a0..a0 + batch * g4],
                     c_prev,
                     c_next,
@@ -225,12 +238,9 @@ struct Cell {
 }
 
 impl Cell {
-    #[allow(clippy::too_many_arguments)]
     fn forward(
         &self,
-        g: &[f32],
-        h_prev: &[f32],
-        w: &[f32],
+        z: &[f32],
         act: &mut [f32],
         c_prev: &[f32],
         c_next: &mut [f32],
@@ -241,27 +251,24 @@ impl Cell {
         if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
         {
             // SAFETY: the CPU has AVX2 and FMA (checked just above).
-            unsafe { self.forward_avx2(g, h_prev, w, act, c_prev, c_next, tc, h_next) };
+            unsafe { self.forward_avx2(z, act, c_prev, c_next, tc, h_next) };
             return;
         }
-        self.forward_body(g, h_prev, w, act, c_prev, c_next, tc, h_next);
+        self.forward_body(z, act, c_prev, c_next, tc, h_next);
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    #[allow(clippy::too_many_arguments)]
     fn forward_avx2(
         &self,
-        g: &[f32],
-        h_prev: &[f32],
-        w: &[f32],
+        z: &[f32],
         act: &mut [f32],
         c_prev: &[f32],
         c_next: &mut [f32],
         tc: &mut [f32],
         h_next: &mut [f32],
     ) {
-        self.forward_body(g, h_prev, w, act, c_prev, c_next, tc, h_next);
+        self.forward_body(z, act, c_prev, c_next, tc, h_next);
     }
 
     /// Gate gradients of one step into `dz` (rows `ld` apart) from `dh` and the running `dc`
@@ -332,12 +339,9 @@ impl Cell {
     }
 
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     fn forward_body(
         &self,
-        g: &[f32],
-        h_prev: &[f32],
-        w: &[f32],
+        z: &[f32],
         act: &mut [f32],
         c_prev: &[f32],
         c_next: &mut [f32],
@@ -345,16 +349,8 @@ impl Cell {
         h_next: &mut [f32],
     ) {
         let (h, g4) = (self.h, 4 * self.h);
-        let mut zbuf = vec![0.0f32; g4];
         for b in 0..self.batch {
-            // z = g_row + h_prev[b]·W_hh: W_hh (H × 4H) stays in L1 across the batch.
-            let z = &mut zbuf[..];
-            z.copy_from_slice(&g[b * self.ld..b * self.ld + g4]);
-            for (k, &hk) in h_prev[b * h..(b + 1) * h].iter().enumerate() {
-                for (zj, wj) in z.iter_mut().zip(&w[k * g4..(k + 1) * g4]) {
-                    *zj += hk * wj;
-                }
-            }
+            let z = &z[b * self.ld..b * self.ld + g4];
             let a = &mut act[b * g4..(b + 1) * g4];
             sigmoid_into(&z[..2 * h], &mut a[..2 * h]);
             tanh_into(&z[2 * h..3 * h], &mut a[2 * h..3 * h]);
