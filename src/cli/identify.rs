@@ -149,18 +149,8 @@ fn stream(model: &mut Model, out: &Path) -> Result<()> {
         .position(|n| railforce::identify::TIME_COLUMNS.contains(&n.as_str()))
         .context("stdin: no time column (time_s, time or t)")?;
     let spec = model.meta.data.clone();
-    let pick: Vec<usize> = spec
-        .channels
-        .iter()
-        .map(|c| {
-            let noisy = spec.noise.column(c, railforce::features::Part::Test);
-            names
-                .iter()
-                .position(|n| *n == noisy)
-                .or_else(|| names.iter().position(|n| n == c))
-                .with_context(|| format!("stdin: missing channel {c} required by the model"))
-        })
-        .collect::<Result<_>>()?;
+    let header: Vec<&str> = names.iter().map(String::as_str).collect();
+    let pick = railforce::identify::resolve_channels(&header, model, "stdin")?;
     let mut w: Box<dyn Write> = if out.as_os_str() == "-" {
         Box::new(std::io::stdout().lock())
     } else {
@@ -189,7 +179,7 @@ fn stream(model: &mut Model, out: &Path) -> Result<()> {
         };
         let t = num(time_k, "time")?;
         if let Some(p) = last_t
-            && ((t - p) - 0.005).abs() > 5e-5
+            && !railforce::identify::is_regular_step(t - p)
         {
             bail!(
                 "stdin rows {}–{}: step {:.6} s; streaming needs 200 Hz without gaps",

@@ -266,26 +266,23 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
             opts.plan.display()
         )));
     }
-    if matches!(which, Which::Comparison | Which::All) {
+    for (part, folder) in [
+        (Which::Comparison, "comparison"),
+        (Which::Generalization, "generalization"),
+        (Which::Robustness, "robustness"),
+    ] {
+        if which != part && which != Which::All {
+            continue;
+        }
         let ts = Instant::now();
-        let sec = comparison(&mut ctx, &ds)?;
-        sec.write_files(&opts.out.join("comparison"))?;
-        sections.push(("comparison".into(), sec));
-        timings.insert("comparison_s".into(), json!(ts.elapsed().as_secs_f64()));
-    }
-    if matches!(which, Which::Generalization | Which::All) {
-        let ts = Instant::now();
-        let sec = generalization(&mut ctx, &ds, &conditions)?;
-        sec.write_files(&opts.out.join("generalization"))?;
-        sections.push(("generalization".into(), sec));
-        timings.insert("generalization_s".into(), json!(ts.elapsed().as_secs_f64()));
-    }
-    if matches!(which, Which::Robustness | Which::All) {
-        let ts = Instant::now();
-        let sec = robustness(&mut ctx, &ds)?;
-        sec.write_files(&opts.out.join("robustness"))?;
-        sections.push(("robustness".into(), sec));
-        timings.insert("robustness_s".into(), json!(ts.elapsed().as_secs_f64()));
+        let sec = match part {
+            Which::Comparison => comparison(&mut ctx, &ds)?,
+            Which::Generalization => generalization(&mut ctx, &ds, &conditions)?,
+            _ => robustness(&mut ctx, &ds)?,
+        };
+        sec.write_files(&opts.out.join(folder))?;
+        sections.push((folder.into(), sec));
+        timings.insert(format!("{folder}_s"), json!(ts.elapsed().as_secs_f64()));
     }
     let wall = t0.elapsed().as_secs_f64();
     let meta = json!({

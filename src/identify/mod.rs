@@ -64,6 +64,39 @@ impl SensorTable {
     }
 }
 
+/// For each model channel, the position in `names` of the column to read: its `_noisy` copy
+/// where the model was tested on noisy inputs and the names have one, else the clean name.
+/// The error lists every missing channel.
+pub fn resolve_channels(names: &[&str], model: &Model, source: &str) -> Result<Vec<usize>> {
+    let spec = &model.meta.data;
+    let mut found = Vec::new();
+    let mut missing = Vec::new();
+    for c in &spec.channels {
+        let preferred = spec.noise.column(c, Part::Test);
+        match names
+            .iter()
+            .position(|n| *n == preferred)
+            .or_else(|| names.iter().position(|n| n == c))
+        {
+            Some(k) => found.push(k),
+            None => missing.push(c.as_str()),
+        }
+    }
+    if missing.is_empty() {
+        Ok(found)
+    } else {
+        Err(Error::Domain(format!(
+            "{source}: missing channel(s) {} required by the model",
+            missing.join(", ")
+        )))
+    }
+}
+
+/// Whether a time step is one 200 Hz sample interval (within 1 %).
+pub fn is_regular_step(step: f64) -> bool {
+    (step - 1.0 / RATE_HZ).abs() <= 0.01 / RATE_HZ
+}
+
 /// The model inputs found in a table, in model order, validated.
 #[derive(Debug, Clone)]
 pub struct CheckedInput {
@@ -81,25 +114,11 @@ pub struct CheckedInput {
 /// (rows count from 1 after the header).
 pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<CheckedInput> {
     let spec = &model.meta.data;
-    let mut used = Vec::new();
-    let mut missing = Vec::new();
-    for c in &spec.channels {
-        let preferred = spec.noise.column(c, Part::Test);
-        if table.column(&preferred).is_some() {
-            used.push(preferred);
-        } else if table.column(c).is_some() {
-            used.push(c.clone());
-        } else {
-            missing.push(c.clone());
-        }
-    }
-    if !missing.is_empty() {
-        return Err(Error::Domain(format!(
-            "{}: missing channel(s) {} required by the model",
-            table.source,
-            missing.join(", ")
-        )));
-    }
+    let names: Vec<&str> = table.columns.iter().map(|(n, _)| n.as_str()).collect();
+    let used: Vec<String> = resolve_channels(&names, model, &table.source)?
+        .into_iter()
+        .map(|k| names[k].to_string())
+        .collect();
     let t = &table.time;
     if t.len() < spec.window {
         return Err(Error::Domain(format!(
@@ -130,9 +149,7 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
         )));
     }
     let dt = 1.0 / RATE_HZ;
-    let bad = t
-        .windows(2)
-        .position(|w| ((w[1] - w[0]) - dt).abs() > 0.01 * dt);
+    let bad = t.windows(2).position(|w| !is_regular_step(w[1] - w[0]));
     match bad {
         None => Ok(CheckedInput {
             used,
@@ -216,12 +233,13 @@ pub fn identify(model: &mut Model, input: &CheckedInput) -> Identified {
     let count = n + 1 - w;
     let mut x = Vec::with_capacity(count.min(4096) * w * c);
     let mut out = Vec::with_capacity(count * spec.targets.len());
-    for chunk in (0..count).collect::<Vec<_>>().chunks(4096) {
+    for first in (0..count).step_by(4096) {
+        let last = (first + 4096).min(count);
         x.clear();
-        for &s in chunk {
+        for s in first..last {
             x.extend_from_slice(&rows[s * c..(s + w) * c]);
         }
-        out.extend(model.predict(&x, chunk.len()));
+        out.extend(model.predict(&x, last - first));
     }
     finish(model, &input.time, out, count)
 }

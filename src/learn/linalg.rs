@@ -77,6 +77,71 @@ pub fn gemm_strided(
     }
 }
 
+/// Rows through an affine map: `y[rows×dout] = x·W + b`, `W[din×dout]` (dense layers and the
+/// input projections of the recurrent layers).
+pub fn affine(x: &[f32], rows: usize, din: usize, w: &[f32], b: &[f32], y: &mut Vec<f32>) {
+    let dout = b.len();
+    y.clear();
+    y.resize(rows * dout, 0.0);
+    gemm(rows, din, dout, x, false, w, false, y, 0.0);
+    add_bias(y, b);
+}
+
+/// Backward of [`affine`] for the weight and the input: `dW += xᵀ·dy`, and `dx = dy·Wᵀ` when
+/// asked (the bias gradient is the column sums of `dy`: [`add_col_sums`]).
+#[allow(clippy::too_many_arguments)]
+pub fn affine_backward(
+    x: &[f32],
+    dy: &[f32],
+    rows: usize,
+    din: usize,
+    dout: usize,
+    w: &[f32],
+    dw: &mut [f32],
+    dx: Option<&mut Vec<f32>>,
+) {
+    gemm(din, rows, dout, x, true, dy, false, dw, 1.0);
+    if let Some(dx) = dx {
+        dx.clear();
+        dx.resize(rows * din, 0.0);
+        gemm(rows, dout, din, dy, false, w, true, dx, 0.0);
+    }
+}
+
+/// Whether the CPU has AVX2 and FMA (checked once by the standard library, then cached).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+pub fn has_avx2_fma() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
+
+/// Defines `fn $name(&self, args…)` that runs `$body` compiled with AVX2 + FMA where the CPU
+/// has them (through a `#[target_feature]` twin `$fast`) and as baseline code otherwise. The
+/// body must be `#[inline(always)]` so that each twin gets its own code generation.
+macro_rules! avx2_dispatch {
+    ($(#[$meta:meta])* fn $name:ident / $fast:ident => $body:ident (&self, $($arg:ident: $ty:ty),* $(,)?)) => {
+        $(#[$meta])*
+        #[allow(clippy::too_many_arguments)]
+        fn $name(&self, $($arg: $ty),*) {
+            #[cfg(target_arch = "x86_64")]
+            if $crate::learn::linalg::has_avx2_fma() {
+                // SAFETY: the CPU has AVX2 and FMA (checked just above).
+                unsafe { self.$fast($($arg),*) };
+                return;
+            }
+            self.$body($($arg),*);
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma")]
+        #[allow(clippy::too_many_arguments)]
+        fn $fast(&self, $($arg: $ty),*) {
+            self.$body($($arg),*);
+        }
+    };
+}
+pub(crate) use avx2_dispatch;
+
 /// Adds the column sums of `x[rows×cols]` to `out[cols]`.
 pub fn add_col_sums(x: &[f32], cols: usize, out: &mut [f32]) {
     for row in x.chunks_exact(cols) {

@@ -6,6 +6,10 @@
 use crate::error::{Error, Result};
 use crate::features::{DataSet, LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// Per-run row-major matrices, shared between the parts that read them.
+type Shared = Arc<Vec<Vec<f32>>>;
 
 /// What a model is trained on: everything needed to rebuild the same windows later.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -38,8 +42,11 @@ pub struct WindowSet {
     /// The windows (run, first step).
     pub windows: Vec<Window>,
     label_offset: usize,
-    x: Vec<Vec<f32>>,
-    y: Vec<Vec<f32>>,
+    /// Per run, the standardised inputs `[rows × C]` (shared between parts reading the same
+    /// columns).
+    x: Shared,
+    /// Per run, the standardised targets `[rows × outputs]` (shared by all parts).
+    y: Shared,
 }
 
 impl WindowSet {
@@ -153,23 +160,35 @@ pub fn prepare(
         ),
     };
     let offset = label_offset(spec.window, spec.label_at);
-    let y: Vec<Vec<f32>> = ds
-        .runs
-        .iter()
-        .map(|r| interleave(r, &target_cols, &target_stats))
-        .collect();
-    let set = |cols: &[usize], windows: &[Window]| -> WindowSet {
+    let y: Shared = Arc::new(
+        ds.runs
+            .iter()
+            .map(|r| interleave(r, &target_cols, &target_stats))
+            .collect(),
+    );
+    // Each distinct column list is standardised once (the parts usually read the same view).
+    let mut views: Vec<(Vec<usize>, Shared)> = Vec::new();
+    let mut set = |cols: &[usize], windows: &[Window]| -> WindowSet {
+        let x = match views.iter().find(|(c, _)| c == cols) {
+            Some((_, x)) => x.clone(),
+            None => {
+                let x: Shared = Arc::new(
+                    ds.runs
+                        .iter()
+                        .map(|r| interleave(r, cols, &input_stats))
+                        .collect(),
+                );
+                views.push((cols.to_vec(), x.clone()));
+                x
+            }
+        };
         WindowSet {
             window: spec.window,
             channels: cols.len(),
             outputs: target_cols.len(),
             windows: windows.to_vec(),
             label_offset: offset,
-            x: ds
-                .runs
-                .iter()
-                .map(|r| interleave(r, cols, &input_stats))
-                .collect(),
+            x,
             y: y.clone(),
         }
     };

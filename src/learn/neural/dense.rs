@@ -2,7 +2,7 @@
 //! it is exactly a Conv1d with kernel 1 over time (spec learning.md §3, layers 1 and 3).
 
 use super::params::ParamSet;
-use crate::learn::linalg::{add_bias, add_col_sums, gemm};
+use crate::learn::linalg::{add_col_sums, affine, affine_backward};
 use rand::Rng;
 use std::ops::Range;
 
@@ -28,20 +28,14 @@ impl Dense {
 
     /// `y[rows×out] = x·W + b`.
     pub fn forward(&self, p: &ParamSet, x: &[f32], rows: usize, y: &mut Vec<f32>) {
-        y.clear();
-        y.resize(rows * self.dout, 0.0);
-        gemm(
+        affine(
+            x,
             rows,
             self.din,
-            self.dout,
-            x,
-            false,
             &p.value[self.w.clone()],
-            false,
+            &p.value[self.b.clone()],
             y,
-            0.0,
         );
-        add_bias(y, &p.value[self.b.clone()]);
     }
 
     /// Accumulates `dW += xᵀ·dy`, `db += Σ dy`; writes `dx = dy·Wᵀ` when asked.
@@ -53,33 +47,9 @@ impl Dense {
         rows: usize,
         dx: Option<&mut Vec<f32>>,
     ) {
-        let (din, dout) = (self.din, self.dout);
-        gemm(
-            din,
-            rows,
-            dout,
-            x,
-            true,
-            dy,
-            false,
-            &mut p.grad[self.w.clone()],
-            1.0,
-        );
-        add_col_sums(dy, dout, &mut p.grad[self.b.clone()]);
-        if let Some(dx) = dx {
-            dx.clear();
-            dx.resize(rows * din, 0.0);
-            gemm(
-                rows,
-                dout,
-                din,
-                dy,
-                false,
-                &p.value[self.w.clone()],
-                true,
-                dx,
-                0.0,
-            );
-        }
+        let w = &p.value[self.w.clone()];
+        let dw = &mut p.grad[self.w.clone()];
+        affine_backward(x, dy, rows, self.din, self.dout, w, dw, dx);
+        add_col_sums(dy, self.dout, &mut p.grad[self.b.clone()]);
     }
 }

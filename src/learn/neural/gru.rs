@@ -3,7 +3,7 @@
 //! `h' = (1 − z)⊙n + z⊙h`. The input projection of all steps is one matrix product.
 
 use super::params::ParamSet;
-use crate::learn::linalg::{add_bias, add_col_sums, fast_exp, gemm, sigmoid};
+use crate::learn::linalg::{add_col_sums, affine, affine_backward, fast_exp, gemm, sigmoid};
 use rand::Rng;
 use std::ops::Range;
 
@@ -64,20 +64,14 @@ impl Gru {
         self.batch = batch;
         self.steps = steps;
         let rows = batch * steps;
-        self.g.clear();
-        self.g.resize(rows * g3, 0.0);
-        gemm(
+        affine(
+            x,
             rows,
             d,
-            g3,
-            x,
-            false,
             &p.value[self.w_ih.clone()],
-            false,
+            &p.value[self.b_ih.clone()],
             &mut self.g,
-            0.0,
         );
-        add_bias(&mut self.g, &p.value[self.b_ih.clone()]);
         self.hs.clear();
         self.hs.resize((steps + 1) * batch * h, 0.0);
         self.act.clear();
@@ -188,31 +182,8 @@ impl Gru {
             std::mem::swap(&mut dh, &mut dh_next);
         }
         add_col_sums(&dgi, g3, &mut p.grad[self.b_ih.clone()]);
-        gemm(
-            d,
-            rows,
-            g3,
-            x,
-            true,
-            &dgi,
-            false,
-            &mut p.grad[self.w_ih.clone()],
-            1.0,
-        );
-        if let Some(dx) = dx {
-            dx.clear();
-            dx.resize(rows * d, 0.0);
-            gemm(
-                rows,
-                g3,
-                d,
-                &dgi,
-                false,
-                &p.value[self.w_ih.clone()],
-                true,
-                dx,
-                0.0,
-            );
-        }
+        let w = &p.value[self.w_ih.clone()];
+        let dw = &mut p.grad[self.w_ih.clone()];
+        affine_backward(x, &dgi, rows, d, g3, w, dw, dx);
     }
 }

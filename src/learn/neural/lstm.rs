@@ -8,7 +8,10 @@
 //! parameter count is the spec's 24 000 for D = 128, H = 20.
 
 use super::params::ParamSet;
-use crate::learn::linalg::{add_bias, add_col_sums, gemm, gemm_strided, sigmoid_into, tanh_into};
+use crate::learn::linalg::{
+    add_bias, add_col_sums, affine, affine_backward, avx2_dispatch, gemm_strided, sigmoid_into,
+    tanh_into,
+};
 use rand::Rng;
 use std::ops::Range;
 
@@ -74,20 +77,9 @@ impl BiLstm {
         self.batch = batch;
         self.steps = steps;
         let rows = batch * steps;
-        // Buffers are fully overwritten below: no zeroing but the initial states.
-        self.g.resize(rows * 2 * g4, 0.0);
-        gemm(
-            rows,
-            d,
-            2 * g4,
-            x,
-            false,
-            &p.value[self.w_ih.clone()],
-            false,
-            &mut self.g,
-            0.0,
-        );
-        add_bias(&mut self.g, &p.value[self.b_ih.clone()]);
+        // Buffers below are fully overwritten: no zeroing but the initial states.
+        let (w_ih, b_ih) = (&p.value[self.w_ih.clone()], &p.value[self.b_ih.clone()]);
+        affine(x, rows, d, w_ih, b_ih, &mut self.g);
         add_bias(&mut self.g, &p.value[self.b_hh.clone()]);
         let state = 2 * (steps + 1) * batch * h;
         self.cs.resize(state, 0.0);
@@ -199,32 +191,9 @@ impl BiLstm {
             p.grad[self.b_ih.start + k] += v;
             p.grad[self.b_hh.start + k] += v;
         }
-        gemm(
-            d,
-            rows,
-            2 * g4,
-            x,
-            true,
-            &dg,
-            false,
-            &mut p.grad[self.w_ih.clone()],
-            1.0,
-        );
-        if let Some(dx) = dx {
-            dx.clear();
-            dx.resize(rows * d, 0.0);
-            gemm(
-                rows,
-                2 * g4,
-                d,
-                &dg,
-                false,
-                &p.value[self.w_ih.clone()],
-                true,
-                dx,
-                0.0,
-            );
-        }
+        let w = &p.value[self.w_ih.clone()];
+        let dw = &mut p.grad[self.w_ih.clone()];
+        affine_backward(x, &dg, rows, d, 2 * g4, w, dw, dx);
     }
 }
 
@@ -238,72 +207,31 @@ struct Cell {
 }
 
 impl Cell {
-    fn forward(
-        &self,
-        z: &[f32],
-        act: &mut [f32],
-        c_prev: &[f32],
-        c_next: &mut [f32],
-        tc: &mut [f32],
-        h_next: &mut [f32],
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
-            // SAFETY: the CPU has AVX2 and FMA (checked just above).
-            unsafe { self.forward_avx2(z, act, c_prev, c_next, tc, h_next) };
-            return;
-        }
-        self.forward_body(z, act, c_prev, c_next, tc, h_next);
+    avx2_dispatch! {
+        /// Gates, cell and hidden state of one step (rows of `z` are `ld` apart).
+        fn forward / forward_avx2 => forward_body(
+            &self,
+            z: &[f32],
+            act: &mut [f32],
+            c_prev: &[f32],
+            c_next: &mut [f32],
+            tc: &mut [f32],
+            h_next: &mut [f32],
+        )
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn forward_avx2(
-        &self,
-        z: &[f32],
-        act: &mut [f32],
-        c_prev: &[f32],
-        c_next: &mut [f32],
-        tc: &mut [f32],
-        h_next: &mut [f32],
-    ) {
-        self.forward_body(z, act, c_prev, c_next, tc, h_next);
-    }
-
-    /// Gate gradients of one step into `dz` (rows `ld` apart) from `dh` and the running `dc`
-    /// (updated to the previous step's).
-    fn backward(
-        &self,
-        act: &[f32],
-        tc: &[f32],
-        c_prev: &[f32],
-        dh: &[f32],
-        dc: &mut [f32],
-        dz: &mut [f32],
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
-            // SAFETY: the CPU has AVX2 and FMA (checked just above).
-            unsafe { self.backward_avx2(act, tc, c_prev, dh, dc, dz) };
-            return;
-        }
-        self.backward_body(act, tc, c_prev, dh, dc, dz);
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn backward_avx2(
-        &self,
-        act: &[f32],
-        tc: &[f32],
-        c_prev: &[f32],
-        dh: &[f32],
-        dc: &mut [f32],
-        dz: &mut [f32],
-    ) {
-        self.backward_body(act, tc, c_prev, dh, dc, dz);
+    avx2_dispatch! {
+        /// Gate gradients of one step into `dz` (rows `ld` apart) from `dh` and the running
+        /// `dc` (updated to the previous step's).
+        fn backward / backward_avx2 => backward_body(
+            &self,
+            act: &[f32],
+            tc: &[f32],
+            c_prev: &[f32],
+            dh: &[f32],
+            dc: &mut [f32],
+            dz: &mut [f32],
+        )
     }
 
     #[inline(always)]
