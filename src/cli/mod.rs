@@ -91,7 +91,8 @@ enum Command {
     /// The whole chain in a few minutes: simulate three short conditions, train a CNN-BiLSTM
     /// and GBDT, sweep four SNRs, and write the report (demo/index.html).
     Demo(experiment::DemoArgs),
-    /// Check railforce against reference solutions (`validate contact`, `validate dynamics`).
+    /// Check railforce against reference solutions and in closed loop (`validate contact`,
+    /// `validate dynamics`, `validate identify`).
     Validate(validate::ValidateArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
     /// `bench learn`).
