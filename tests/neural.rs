@@ -124,3 +124,42 @@ fn same_seed_gives_same_weights_and_outputs() {
     other.seed = 8;
     assert_ne!(Network::new(other).params.value, a.params.value);
 }
+
+#[test]
+fn fused_evaluation_matches_the_layer_by_layer_path() {
+    use railforce::learn::neural::Adam;
+    for arch in [
+        Architecture::CnnBiLstm,
+        Architecture::Cnn,
+        Architecture::BiLstm,
+        Architecture::Gru,
+    ] {
+        let (c, o) = (21, 2);
+        let mut net = Network::new(config(arch, c, o, 0.2));
+        // A few training steps so that batch-norm running statistics and weights move away
+        // from their initial values.
+        let mut adam = Adam::new(net.params.value.len(), 1e-2);
+        let (x, y) = data(32, c, o);
+        for _ in 0..5 {
+            net.params.zero_grad();
+            let out = net.forward(&x, 32, true).to_vec();
+            let dout: Vec<f32> = out.iter().zip(&y).map(|(p, t)| p - t).collect();
+            net.backward(&x, &dout);
+            adam.step(&mut net.params);
+        }
+        // 1 window, and 130 windows across the evaluation path's chunk boundaries.
+        for batch in [1, 130] {
+            let (x, _) = data(batch, c, o);
+            let fused = net.forward(&x, batch, false).to_vec();
+            let reference = net.forward_reference(&x, batch).to_vec();
+            assert_eq!(fused.len(), batch * o);
+            let scale = reference.iter().map(|v| v.abs()).fold(1e-3, f32::max);
+            for (a, b) in fused.iter().zip(&reference) {
+                assert!(
+                    (a - b).abs() <= 2e-5 * scale,
+                    "{arch:?} batch {batch}: fused {a} vs reference {b}"
+                );
+            }
+        }
+    }
+}

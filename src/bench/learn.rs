@@ -21,6 +21,11 @@ pub struct NetBench {
     pub pytorch_train_reference: f64,
 }
 
+/// Spec §5 reference: PyTorch CNN-BiLSTM inference in batches of 64–1 024, windows/s.
+pub const PYTORCH_INFER_WINDOWS_PER_S: f64 = 40_000.0;
+/// Spec §5 reference: PyTorch CNN-BiLSTM inference of one window, ms.
+pub const PYTORCH_SINGLE_MS: f64 = 0.22;
+
 /// Spec §5 reference training rates (batch 64).
 pub fn pytorch_reference(a: Architecture) -> f64 {
     match a {

@@ -71,8 +71,12 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 "single window",
                 "train/GFLOP"
             );
+            let mut paper_net = None;
             for a in [A::CnnBiLstm, A::Cnn, A::BiLstm, A::Gru] {
                 let b = learn::run(a, 64, seconds);
+                if a == A::CnnBiLstm {
+                    paper_net = Some(b.clone());
+                }
                 println!(
                     "{:<11} {:>14.0} {:>9.2}× {:>12.0} {:>11.3} ms {:>12.1}",
                     a.name(),
@@ -81,6 +85,15 @@ pub fn run(args: BenchArgs) -> Result<()> {
                     b.infer_windows_per_s,
                     b.single_ms,
                     b.train_windows_per_s / gf
+                );
+            }
+            if let Some(b) = paper_net {
+                println!(
+                    "cnn-bilstm inference vs PyTorch (spec §5: {:.0} windows/s batched, {:.2} ms one window): {:.2}× batched, {:.1}× one window",
+                    learn::PYTORCH_INFER_WINDOWS_PER_S,
+                    learn::PYTORCH_SINGLE_MS,
+                    b.infer_windows_per_s / learn::PYTORCH_INFER_WINDOWS_PER_S,
+                    learn::PYTORCH_SINGLE_MS / b.single_ms
                 );
             }
             let lat = learn::streaming_latency_us(5000);

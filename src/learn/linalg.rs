@@ -82,9 +82,11 @@ pub fn gemm_strided(
 pub fn affine(x: &[f32], rows: usize, din: usize, w: &[f32], b: &[f32], y: &mut Vec<f32>) {
     let dout = b.len();
     y.clear();
-    y.resize(rows * dout, 0.0);
-    gemm(rows, din, dout, x, false, w, false, y, 0.0);
-    add_bias(y, b);
+    for _ in 0..rows {
+        y.extend_from_slice(b);
+    }
+    // The bias rows are C's initial value: one pass less than zeroing and adding afterwards.
+    gemm(rows, din, dout, x, false, w, false, y, 1.0);
 }
 
 /// Backward of [`affine`] for the weight and the input: `dW += xᵀ·dy`, and `dx = dy·Wᵀ` when
@@ -176,8 +178,11 @@ pub fn fast_exp(x: f32) -> f32 {
     const LN2_HI: f32 = 0.693_359_4;
     const LN2_LO: f32 = -2.121_944_4e-4;
     let x = x.clamp(-87.0, 87.0);
-    // Round to nearest by the 1.5·2^23 trick (vectorises, unlike f32::round).
-    let n = (x * LOG2E + 12_582_912.0) - 12_582_912.0;
+    // Round to nearest by the 1.5·2^23 trick (vectorises, unlike f32::round): the sum's low
+    // mantissa bits are n itself, so 2^n is built with integer arithmetic only (a float →
+    // int `as` cast saturates and does not vectorise).
+    let shifted = x * LOG2E + 12_582_912.0;
+    let n = shifted - 12_582_912.0;
     let r = x - n * LN2_HI - n * LN2_LO;
     let p = 1.987_569_1e-4;
     let p = p * r + 1.398_199_9e-3;
@@ -186,7 +191,12 @@ pub fn fast_exp(x: f32) -> f32 {
     let p = p * r + 1.666_666_5e-1;
     let p = p * r + 0.5;
     let e = p * r * r + r + 1.0;
-    e * f32::from_bits(((n as i32 + 127) << 23) as u32)
+    let two_n = (shifted
+        .to_bits()
+        .wrapping_sub(0x4B40_0000)
+        .wrapping_add(127))
+        << 23;
+    e * f32::from_bits(two_n)
 }
 
 /// `dst = σ(src)` elementwise.

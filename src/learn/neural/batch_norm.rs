@@ -92,6 +92,21 @@ impl BatchNorm {
         }
     }
 
+    /// The evaluation-mode layer as a per-channel affine map `y = scale·x + shift` (running
+    /// statistics).
+    pub fn eval_affine(&self, p: &ParamSet) -> (Vec<f32>, Vec<f32>) {
+        let (gamma, beta) = (&p.value[self.gamma.clone()], &p.value[self.beta.clone()]);
+        let (mean, var) = (
+            &p.value[self.running_mean.clone()],
+            &p.value[self.running_var.clone()],
+        );
+        let scale: Vec<f32> = (0..self.c)
+            .map(|k| gamma[k] * (1.0 / (var[k] + EPS).sqrt()))
+            .collect();
+        let shift = (0..self.c).map(|k| beta[k] - mean[k] * scale[k]).collect();
+        (scale, shift)
+    }
+
     /// Turns `dy` into `dx` in place and accumulates dγ, dβ:
     /// `dx = γ/σ · (dy − mean(dy) − x̂·mean(dy·x̂))`.
     pub fn backward(&self, p: &mut ParamSet, dy: &mut [f32]) {

@@ -9,8 +9,8 @@
 
 use super::params::ParamSet;
 use crate::learn::linalg::{
-    add_bias, add_col_sums, affine, affine_backward, avx2_dispatch, gemm_strided, sigmoid_into,
-    tanh_into,
+    add_bias, add_col_sums, affine, affine_backward, avx2_dispatch, fast_exp, gemm_strided,
+    sigmoid_into, tanh_into,
 };
 use rand::Rng;
 use std::ops::Range;
@@ -134,6 +134,54 @@ impl BiLstm {
                     .copy_from_slice(&self.hs[last + b * h..last + (b + 1) * h]);
             }
         }
+    }
+
+    /// Evaluation-mode forward: `x[B, T, D]` → final states `out[B, 2H]`, keeping no caches.
+    /// The input projection is one matrix product (both biases folded into its initial
+    /// value); the recurrence runs window by window with the recurrent product and the cell
+    /// fused ([`Recurrence`]), the state held in registers. Same numbers as [`BiLstm::forward`]
+    /// up to rounding.
+    pub fn forward_eval(
+        &self,
+        p: &ParamSet,
+        x: &[f32],
+        batch: usize,
+        steps: usize,
+        gates: &mut Vec<f32>,
+        out: &mut Vec<f32>,
+    ) {
+        let (h, g4) = (self.h, 4 * self.h);
+        if h != H {
+            // The fused kernel is compiled for the networks' width; others take the
+            // training path (same numbers, with caches).
+            let mut copy = self.clone();
+            copy.forward(p, x, batch, steps, out);
+            return;
+        }
+        let bias: Vec<f32> = p.value[self.b_ih.clone()]
+            .iter()
+            .zip(&p.value[self.b_hh.clone()])
+            .map(|(a, b)| a + b)
+            .collect();
+        affine(
+            x,
+            batch * steps,
+            self.din,
+            &p.value[self.w_ih.clone()],
+            &bias,
+            gates,
+        );
+        // W_hh with every gate padded to HP columns (zeros), `[2][H][4·HP]`.
+        let w = &p.value[self.w_hh.clone()];
+        let mut wp = vec![0.0f32; 2 * h * 4 * HP];
+        for (dst, src) in wp.chunks_exact_mut(4 * HP).zip(w.chunks_exact(g4)) {
+            for q in 0..4 {
+                dst[q * HP..q * HP + h].copy_from_slice(&src[q * h..(q + 1) * h]);
+            }
+        }
+        out.clear();
+        out.resize(batch * 2 * h, 0.0);
+        Recurrence { steps }.run(gates, &wp, out);
     }
 
     /// Backpropagation through time from `dout[B, 2H]`; accumulates the weight gradients and
@@ -292,6 +340,195 @@ impl Cell {
             let hn = &mut h_next[b * h..(b + 1) * h];
             for k in 0..h {
                 hn[k] = a[3 * h + k] * t[k];
+            }
+        }
+    }
+}
+
+/// Hidden width the evaluation kernel is compiled for (the networks' 20 units).
+const H: usize = 20;
+/// Width of the evaluation kernel's gate blocks: [`H`] padded to whole 8-lane vectors.
+const HP: usize = 24;
+
+/// The evaluation-mode recurrence of both directions, one window at a time: for each step
+/// `z = G[t] + h·W_hh` and the cell, on gate blocks padded to [`HP`] lanes (the padded
+/// weights are zero, so padded lanes stay at c = h = 0). The state of one window never
+/// leaves the core's registers and L1; a batch-wide product per step (the training path)
+/// pays packing and strided stores for a 20-deep product instead.
+struct Recurrence {
+    steps: usize,
+}
+
+impl Recurrence {
+    /// `g[B·T, 8H]` gate inputs, `wp[2][H][4·HP]`, `out[B, 2H]`: the AVX2 + FMA kernel where
+    /// the CPU has them, portable code otherwise.
+    fn run(&self, g: &[f32], wp: &[f32], out: &mut [f32]) {
+        assert!(g.len() >= out.len() / (2 * H) * self.steps * 8 * H);
+        assert_eq!(wp.len(), 2 * H * 4 * HP);
+        #[cfg(target_arch = "x86_64")]
+        if crate::learn::linalg::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA (checked just above); the lengths are checked
+            // above.
+            unsafe { avx2::run(self.steps, g, wp, out) };
+            return;
+        }
+        self.run_body(g, wp, out);
+    }
+
+    /// Portable version of `avx2::run`.
+    fn run_body(&self, g: &[f32], wp: &[f32], out: &mut [f32]) {
+        let (h, steps) = (H, self.steps);
+        let (g4, g8) = (4 * h, 8 * h);
+        for (b, out) in out.chunks_exact_mut(2 * h).enumerate() {
+            let gb = &g[b * steps * g8..];
+            for dir in 0..2 {
+                let w = &wp[dir * h * 4 * HP..(dir + 1) * h * 4 * HP];
+                let mut hs = [0.0f32; HP];
+                let mut c = [0.0f32; HP];
+                for s in 0..steps {
+                    let t = if dir == 0 { s } else { steps - 1 - s };
+                    let gin = &gb[t * g8 + dir * g4..];
+                    let mut z = [0.0f32; 4 * HP];
+                    for q in 0..4 {
+                        z[q * HP..q * HP + h].copy_from_slice(&gin[q * h..(q + 1) * h]);
+                    }
+                    for (k, &hk) in hs.iter().enumerate().take(h) {
+                        let wr: &[f32; 4 * HP] = w[k * 4 * HP..(k + 1) * 4 * HP]
+                            .try_into()
+                            .expect("row of 4·HP");
+                        for (zj, &wj) in z.iter_mut().zip(wr) {
+                            *zj += hk * wj;
+                        }
+                    }
+                    for j in 0..HP {
+                        let i = 1.0 / (1.0 + fast_exp(-z[j]));
+                        let f = 1.0 / (1.0 + fast_exp(-z[HP + j]));
+                        let gg = 1.0 - 2.0 / (fast_exp(2.0 * z[2 * HP + j]) + 1.0);
+                        let o = 1.0 / (1.0 + fast_exp(-z[3 * HP + j]));
+                        c[j] = f * c[j] + i * gg;
+                        hs[j] = o * (1.0 - 2.0 / (fast_exp(2.0 * c[j]) + 1.0));
+                    }
+                }
+                out[dir * h..(dir + 1) * h].copy_from_slice(&hs[..h]);
+            }
+        }
+    }
+}
+
+/// The evaluation recurrence with AVX2 + FMA intrinsics: the twelve 8-lane gate accumulators
+/// of one step and the cell state stay in registers; `e^x` as [`fast_exp`] (same reduction and
+/// polynomial) and reciprocals by `rcp` with one Newton step (relative error ~1e-7).
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::{H, HP};
+    use std::arch::x86_64::*;
+
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn exp(x: __m256) -> __m256 {
+        let x = _mm256_min_ps(
+            _mm256_max_ps(x, _mm256_set1_ps(-87.0)),
+            _mm256_set1_ps(87.0),
+        );
+        let shifted = _mm256_fmadd_ps(
+            x,
+            _mm256_set1_ps(std::f32::consts::LOG2_E),
+            _mm256_set1_ps(12_582_912.0),
+        );
+        let n = _mm256_sub_ps(shifted, _mm256_set1_ps(12_582_912.0));
+        let r = _mm256_fnmadd_ps(n, _mm256_set1_ps(0.693_359_4), x);
+        let r = _mm256_fnmadd_ps(n, _mm256_set1_ps(-2.121_944_4e-4), r);
+        let mut p = _mm256_set1_ps(1.987_569_1e-4);
+        for c in [
+            1.398_199_9e-3,
+            8.333_452e-3,
+            4.166_579_6e-2,
+            1.666_666_5e-1,
+            0.5,
+        ] {
+            p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(c));
+        }
+        let e = _mm256_fmadd_ps(
+            p,
+            _mm256_mul_ps(r, r),
+            _mm256_add_ps(r, _mm256_set1_ps(1.0)),
+        );
+        // 2^n from the low mantissa bits of `shifted` (see `fast_exp`).
+        let bits = _mm256_add_epi32(
+            _mm256_castps_si256(shifted),
+            _mm256_set1_epi32(127 - 0x4B40_0000),
+        );
+        _mm256_mul_ps(e, _mm256_castsi256_ps(_mm256_slli_epi32::<23>(bits)))
+    }
+
+    /// `1/d` for d ≥ 1: `rcp` (12 bits) and one Newton step `r·(2 − d·r)`.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn recip(d: __m256) -> __m256 {
+        let r = _mm256_rcp_ps(d);
+        _mm256_mul_ps(r, _mm256_fnmadd_ps(d, r, _mm256_set1_ps(2.0)))
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn sigmoid(x: __m256) -> __m256 {
+        let e = exp(_mm256_sub_ps(_mm256_setzero_ps(), x));
+        recip(_mm256_add_ps(_mm256_set1_ps(1.0), e))
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn tanh(x: __m256) -> __m256 {
+        let e = exp(_mm256_add_ps(x, x));
+        let q = recip(_mm256_add_ps(e, _mm256_set1_ps(1.0)));
+        _mm256_fnmadd_ps(_mm256_set1_ps(2.0), q, _mm256_set1_ps(1.0))
+    }
+
+    /// See [`super::Recurrence::run`]; the caller checks the lengths.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn run(steps: usize, g: &[f32], wp: &[f32], out: &mut [f32]) {
+        // SAFETY: the caller checked that `g` holds every window's gates and `wp` both
+        // directions' padded weights; every pointer below stays inside them.
+        unsafe {
+            // The third vector of a 20-wide gate holds 4 values: masked load, zeros beyond.
+            let tail = _mm256_setr_epi32(-1, -1, -1, -1, 0, 0, 0, 0);
+            for (b, out) in out.chunks_exact_mut(2 * H).enumerate() {
+                let gb = g.as_ptr().add(b * steps * 8 * H);
+                for dir in 0..2 {
+                    let w = wp.as_ptr().add(dir * H * 4 * HP);
+                    let mut hbuf = [0.0f32; HP];
+                    let mut c = [_mm256_setzero_ps(); 3];
+                    for s in 0..steps {
+                        let t = if dir == 0 { s } else { steps - 1 - s };
+                        let gin = gb.add(t * 8 * H + dir * 4 * H);
+                        let mut z = [_mm256_setzero_ps(); 12];
+                        for q in 0..4 {
+                            let gq = gin.add(q * H);
+                            z[3 * q] = _mm256_loadu_ps(gq);
+                            z[3 * q + 1] = _mm256_loadu_ps(gq.add(8));
+                            z[3 * q + 2] = _mm256_maskload_ps(gq.add(16), tail);
+                        }
+                        for (k, hk) in hbuf.iter().enumerate().take(H) {
+                            let hk = _mm256_broadcast_ss(hk);
+                            let wr = w.add(k * 4 * HP);
+                            for (j, zj) in z.iter_mut().enumerate() {
+                                *zj = _mm256_fmadd_ps(hk, _mm256_loadu_ps(wr.add(8 * j)), *zj);
+                            }
+                        }
+                        for (v, cv) in c.iter_mut().enumerate() {
+                            let i = sigmoid(z[v]);
+                            let f = sigmoid(z[3 + v]);
+                            let gg = tanh(z[6 + v]);
+                            let o = sigmoid(z[9 + v]);
+                            *cv = _mm256_fmadd_ps(f, *cv, _mm256_mul_ps(i, gg));
+                            _mm256_storeu_ps(
+                                hbuf.as_mut_ptr().add(8 * v),
+                                _mm256_mul_ps(o, tanh(*cv)),
+                            );
+                        }
+                    }
+                    out[dir * H..(dir + 1) * H].copy_from_slice(&hbuf[..H]);
+                }
             }
         }
     }

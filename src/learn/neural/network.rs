@@ -9,7 +9,7 @@ use super::dense::Dense;
 use super::gru::Gru;
 use super::lstm::BiLstm;
 use super::params::ParamSet;
-use crate::learn::linalg::{leaky_relu, leaky_relu_backward};
+use crate::learn::linalg::{LEAKY_SLOPE, leaky_relu, leaky_relu_backward};
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
@@ -175,8 +175,77 @@ impl Network {
     }
 
     /// Forward pass of `x[B, window, channels]` (z-scored); `train` enables dropout and batch
-    /// statistics. Returns `[B, outputs]`.
+    /// statistics and keeps what [`Network::backward`] needs. Returns `[B, outputs]`.
     pub fn forward(&mut self, x: &[f32], batch: usize, train: bool) -> &[f32] {
+        if train {
+            self.forward_layers(x, batch, true)
+        } else {
+            self.forward_eval(x, batch)
+        }
+    }
+
+    /// Evaluation mode on the path training uses (layer by layer, with every cache): the
+    /// reference [`Network::forward`]'s fused evaluation path is tested against.
+    #[doc(hidden)]
+    pub fn forward_reference(&mut self, x: &[f32], batch: usize) -> &[f32] {
+        self.forward_layers(x, batch, false)
+    }
+
+    /// Evaluation mode, fused: windows in cache-sized chunks, batch norm as a per-channel
+    /// affine map applied in place (no copies), no dropout, and the LSTM's fused evaluation
+    /// kernel ([`BiLstm::forward_eval`]).
+    fn forward_eval(&mut self, x: &[f32], batch: usize) -> &[f32] {
+        let (t, c) = (self.config.window, self.config.channels);
+        assert_eq!(
+            x.len(),
+            batch * t * c,
+            "input must be [batch, window, channels]"
+        );
+        let p = &self.params;
+        let bn = self
+            .stem
+            .as_ref()
+            .map(|s| (s.bn1.eval_affine(p), s.bn2.eval_affine(p)));
+        let mut out = std::mem::take(&mut self.out);
+        out.clear();
+        let mut tmp = Vec::new();
+        for chunk in x.chunks(EVAL_CHUNK * t * c) {
+            let n = chunk.len() / (t * c);
+            let (seq, steps): (&[f32], usize) = match (&self.stem, &bn) {
+                (Some(stem), Some(((s1, b1), (s2, b2)))) => {
+                    let rows = n * t;
+                    stem.c1.forward(p, chunk, rows, &mut self.r1);
+                    leaky_affine(&mut self.r1, s1, b1);
+                    stem.c2.forward(p, &self.r1, rows, &mut self.r2);
+                    leaky_affine(&mut self.r2, s2, b2);
+                    max_pool_pairs(&self.r2, n, t, STEM_WIDTH, &mut self.pooled);
+                    (&self.pooled, t - 1)
+                }
+                _ => (chunk, t),
+            };
+            let feat: &[f32] = match &mut self.rnn {
+                Recurrent::Lstm(l) => {
+                    l.forward_eval(p, seq, n, steps, &mut self.n1, &mut self.feat);
+                    &self.feat
+                }
+                Recurrent::Gru(g) => {
+                    g.forward(p, seq, n, steps, &mut self.feat);
+                    &self.feat
+                }
+                Recurrent::None => seq,
+            };
+            self.d1.forward(p, feat, n, &mut self.h1);
+            leaky_relu(&mut self.h1);
+            self.d2.forward(p, &self.h1, n, &mut self.h2);
+            leaky_relu(&mut self.h2);
+            self.d3.forward(p, &self.h2, n, &mut tmp);
+            out.extend_from_slice(&tmp);
+        }
+        self.out = out;
+        &self.out
+    }
+
+    fn forward_layers(&mut self, x: &[f32], batch: usize, train: bool) -> &[f32] {
         let (t, c) = (self.config.window, self.config.channels);
         assert_eq!(
             x.len(),
@@ -321,6 +390,31 @@ impl Network {
             out.extend_from_slice(self.forward(chunk, n, false));
         }
         out
+    }
+}
+
+/// Windows per chunk of the evaluation path: the stem's activations of one chunk
+/// (64 × 20 × 128 floats, 640 KiB) stay in the L2 cache.
+const EVAL_CHUNK: usize = 64;
+
+/// Leaky ReLU then a per-channel affine map (evaluation-mode batch norm), in place on rows.
+fn leaky_affine(x: &mut [f32], scale: &[f32], shift: &[f32]) {
+    for row in x.chunks_exact_mut(scale.len()) {
+        for ((v, a), b) in row.iter_mut().zip(scale).zip(shift) {
+            let y = if *v < 0.0 { *v * LEAKY_SLOPE } else { *v };
+            *v = y * a + b;
+        }
+    }
+}
+
+/// MaxPool1d(2, stride 1) over time of `x[B, T, W]` into `y[B, T−1, W]`.
+fn max_pool_pairs(x: &[f32], batch: usize, t: usize, w: usize, y: &mut Vec<f32>) {
+    y.clear();
+    for b in 0..batch {
+        let src = &x[b * t * w..(b + 1) * t * w];
+        for (u, v) in src.chunks_exact(w).zip(src[w..].chunks_exact(w)) {
+            y.extend(u.iter().zip(v).map(|(a, c)| a.max(*c)));
+        }
     }
 }
 
