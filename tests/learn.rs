@@ -247,3 +247,83 @@ fn classical_models_learn_a_nonlinear_function() {
         );
     }
 }
+
+/// The synthetic set with `_noisy` copies of its inputs at `snr` dB (the data set's noise).
+fn with_noisy(mut ds: DataSet, snr: f64) -> DataSet {
+    let inputs = ["a", "b", "c"];
+    for run in &mut ds.runs {
+        for (k, name) in inputs.iter().enumerate() {
+            let c = ds.names.iter().position(|n| n == name).unwrap();
+            let noisy = railforce::dataset::noise_column(&run.columns[c], snr, run.seed, k);
+            run.columns.push(noisy);
+        }
+    }
+    ds.names.extend(inputs.iter().map(|n| format!("{n}_noisy")));
+    ds
+}
+
+#[test]
+fn fresh_noise_has_the_data_sets_level_and_changes_with_the_seed() {
+    use railforce::learn::windows::{NoiseRefresher, prepare};
+    let ds = with_noisy(synthetic(2, 3000), 6.0);
+    let s = DataSpec {
+        noise: NoiseProtocol::Matched,
+        ..spec()
+    };
+    let prep = prepare(&ds, &s, None).unwrap();
+    let clean = NoiseRefresher::new(&ds, &s, &prep.input_stats, 1000.0).unwrap();
+    let fresh = NoiseRefresher::new(&ds, &s, &prep.input_stats, 6.0).unwrap();
+    let (base, a, a2, b) = (clean.draw(1), fresh.draw(1), fresh.draw(1), fresh.draw(2));
+    assert_eq!(a, a2, "same seed, same draw");
+    assert_ne!(a, b, "another seed, another draw");
+    // Per channel, the noise of the draw and of the data set's fixed copy have the same
+    // spread (the draw is in the training view's standardisation).
+    for r in 0..2 {
+        for (k, name) in ["a", "b", "c"].iter().enumerate() {
+            let col = |m: &[f32]| m.iter().skip(k).step_by(3).copied().collect::<Vec<f32>>();
+            let (x0, xa) = (col(&base[r]), col(&a[r]));
+            let run = &ds.runs[r];
+            let ci = ds.names.iter().position(|n| n == name).unwrap();
+            let ni = ds.names.len() - 3 + k;
+            let std = |v: &[f64]| {
+                let m = v.iter().sum::<f64>() / v.len() as f64;
+                (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+            };
+            let fixed_noise: Vec<f64> = run.columns[ni]
+                .iter()
+                .zip(&run.columns[ci])
+                .map(|(n, c)| n - c)
+                .collect();
+            let drawn: Vec<f64> = xa
+                .iter()
+                .zip(&x0)
+                .map(|(n, c)| ((n - c) as f64) * prep.input_stats.std[k])
+                .collect();
+            let ratio = std(&drawn) / std(&fixed_noise);
+            assert!(
+                (ratio - 1.0).abs() < 0.06,
+                "run {r} channel {k}: drawn σ / data set σ = {ratio}"
+            );
+        }
+    }
+}
+
+#[test]
+fn fresh_noise_needs_the_matched_protocol() {
+    let ds = with_noisy(synthetic(1, 400), 6.0);
+    let opts = TrainOptions {
+        fresh_noise_snr_db: Some(6.0),
+        ..quick(1)
+    };
+    let err = train(
+        &ds,
+        &spec(),
+        ModelKind::CnnBiLstm,
+        &opts,
+        &tmp("fresh"),
+        &mut |_| {},
+    )
+    .err()
+    .unwrap();
+    assert!(err.to_string().contains("matched"), "{err}");
+}

@@ -56,6 +56,11 @@ pub struct ExperimentArgs {
     /// last (causal, usable on board in real time).
     #[arg(long)]
     centre_label: bool,
+    /// Train the networks on the one fixed noisy copy of the inputs instead of drawing new
+    /// noise every epoch (the default draws fresh noise at the same SNR; validation and test
+    /// keep their fixed noise either way).
+    #[arg(long)]
+    fixed_noise: bool,
 }
 
 fn run_with(which: Which, opts: &ExperimentOptions) -> Result<()> {
@@ -82,6 +87,7 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
     opts.condition = args.condition;
     opts.snr_db = args.snr_db;
     opts.jobs = args.jobs;
+    opts.fresh_noise = !args.fixed_noise;
     if args.centre_label {
         opts.label_at = railforce::features::LabelAt::Centre;
     }

@@ -79,6 +79,11 @@ pub struct TrainArgs {
     /// Continue from the checkpoint in --out (same data and settings).
     #[arg(long)]
     resume: bool,
+    /// Networks, matched protocol: draw new training-input noise every epoch at the data
+    /// set's SNR (its manifest's `snr_db`) instead of learning one fixed noise realisation;
+    /// validation and test keep the data set's noisy columns.
+    #[arg(long)]
+    fresh_noise: bool,
 }
 
 /// Resolves the data options into a [`DataSpec`].
@@ -154,6 +159,16 @@ pub fn run(args: TrainArgs) -> Result<()> {
         windows_per_epoch: args.windows_per_epoch,
         classical_rows: args.classical_rows,
         resume: args.resume,
+        fresh_noise_snr_db: if args.fresh_noise {
+            Some(ds.snr_db().with_context(|| {
+                format!(
+                    "--fresh-noise: {}/manifest.json records no snr_db (generate with --snr-db)",
+                    args.data.data.display()
+                )
+            })?)
+        } else {
+            None
+        },
         ..TrainOptions::default()
     };
     println!(

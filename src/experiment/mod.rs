@@ -60,6 +60,9 @@ pub struct ExperimentOptions {
     pub jobs: usize,
     /// Label position (the last step: causal, the default; the centre: as the paper reads).
     pub label_at: LabelAt,
+    /// Networks trained at an SNR (matched protocol) draw new training-input noise every
+    /// epoch instead of learning one fixed realisation (validation and test keep theirs).
+    pub fresh_noise: bool,
 }
 
 impl ExperimentOptions {
@@ -87,6 +90,7 @@ impl ExperimentOptions {
             },
             jobs: 2,
             label_at: LabelAt::Last,
+            fresh_noise: true,
         }
     }
 }
@@ -175,18 +179,26 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// Trains `kind`; with the matched protocol at `snr` dB, networks draw fresh training
+    /// noise every epoch when the options say so ([`ExperimentOptions::fresh_noise`]).
     fn fit(
         &mut self,
         ds: &DataSet,
         spec: &DataSpec,
         kind: ModelKind,
         dir: &Path,
+        snr: Option<f64>,
     ) -> Result<(Model, f64)> {
         let t0 = Instant::now();
         let name = format!("{} → {}", kind.name(), dir.display());
         (self.log)(format!("training {name}"));
         let log = &mut self.log;
-        let model = train(ds, spec, kind, &self.opts.train, dir, &mut |p| {
+        let opts = TrainOptions {
+            fresh_noise_snr_db: snr
+                .filter(|_| self.opts.fresh_noise && spec.noise == NoiseProtocol::Matched),
+            ..self.opts.train.clone()
+        };
+        let model = train(ds, spec, kind, &opts, dir, &mut |p| {
             if let Progress::Epoch(e) = p
                 && (e.epoch % 10 == 0 || e.epoch == 1)
             {
@@ -294,6 +306,7 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
         "condition": opts.condition,
         "training": opts.train,
         "label_at": format!("{:?}", opts.label_at),
+        "fresh_noise_every_epoch": opts.fresh_noise,
         "railforce_version": env!("CARGO_PKG_VERSION"),
         "wall_seconds": wall,
         "timings": timings,
@@ -320,7 +333,7 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
             }
         ),
         format!(
-            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch; classical models on at most {} windows.",
+            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch{}; classical models on at most {} windows.",
             opts.train.lr,
             opts.train.batch,
             opts.train.epochs,
@@ -329,6 +342,11 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
                 .windows_per_epoch
                 .map(|w| w.to_string())
                 .unwrap_or("all".into()),
+            if opts.fresh_noise {
+                "; networks trained at an SNR draw new input noise every epoch (validation and test keep one fixed, seeded realisation)"
+            } else {
+                "; networks trained on one fixed noise realisation"
+            },
             opts.train.classical_rows
         ),
     ];
@@ -367,7 +385,7 @@ fn comparison(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
     let mut traces: Option<Vec<PredictionRow>> = None;
     for &kind in &opts.models {
         let mdir = dir.join("models").join(kind.name());
-        let (mut model, secs) = ctx.fit(&dsc, &sp, kind, &mdir)?;
+        let (mut model, secs) = ctx.fit(&dsc, &sp, kind, &mdir, Some(opts.snr_db))?;
         let tr = train_metrics(&mut model, &dsc)?;
         let te = evaluate(&mut model, &dsc, EvalPart::Test)?;
         let paper = paper::COMPARISON
@@ -516,6 +534,7 @@ fn generalization(ctx: &mut Ctx, ds: &DataSet, conditions: &[String]) -> Result<
         &spec(opts.label_at, NoiseProtocol::Matched, Split::default()),
         ModelKind::CnnBiLstm,
         &dir.join("models/all_conditions"),
+        Some(opts.snr_db),
     )?;
     let ev = evaluate(&mut model, &dsn, EvalPart::Test)?;
     let mut t = Table::new(&[
@@ -599,6 +618,7 @@ fn generalization(ctx: &mut Ctx, ds: &DataSet, conditions: &[String]) -> Result<
             &sp,
             ModelKind::CnnBiLstm,
             &dir.join(format!("models/without_{c}")),
+            Some(opts.snr_db),
         )?;
         let e = evaluate(&mut m, &dsn, EvalPart::Test)?;
         let seen = in_dist.get(c).copied().unwrap_or((f64::NAN, f64::NAN));
@@ -674,6 +694,7 @@ fn robustness(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
                     &spec(opts.label_at, NoiseProtocol::Clean, Split::default()),
                     kind,
                     &dir.join(format!("models/clean_{}", kind.name())),
+                    None,
                 )?;
                 m.meta.data.noise = NoiseProtocol::TrainCleanTestNoisy;
                 Some(m)
@@ -691,6 +712,7 @@ fn robustness(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
                             &spec(opts.label_at, NoiseProtocol::Matched, Split::default()),
                             kind,
                             &dir.join(format!("models/matched_{}_{snr}dB", kind.name())),
+                            Some(snr),
                         )?;
                         evaluate(&mut m, &dsn, EvalPart::Test)?
                     }

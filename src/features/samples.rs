@@ -43,6 +43,13 @@ pub struct DataSet {
 }
 
 impl DataSet {
+    /// The SNR of the noisy input copies, dB, as the manifest records it (`None` for a clean
+    /// data set or one held only in memory).
+    pub fn snr_db(&self) -> Option<f64> {
+        let text = crate::io::read_text(&self.dir.join("manifest.json")).ok()?;
+        serde_json::from_str::<serde_json::Value>(&text).ok()?["snr_db"].as_f64()
+    }
+
     /// Reads `manifest.json` and every run file it lists (npz, parquet or csv).
     pub fn load(dir: &Path) -> Result<Self> {
         let mpath = dir.join("manifest.json");

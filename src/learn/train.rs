@@ -6,9 +6,9 @@ use super::classical::{Classical, ClassicalParams};
 use super::metrics::metrics;
 use super::model::{Engine, Model, ModelKind, ModelMeta, read_weights, write_weights};
 use super::neural::{Adam, NetConfig, Network};
-use super::windows::{DataSpec, WindowSet, prepare};
+use super::windows::{DataSpec, NoiseRefresher, WindowSet, prepare};
 use crate::error::{Error, Result};
-use crate::features::DataSet;
+use crate::features::{DataSet, NoiseProtocol};
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
@@ -38,6 +38,10 @@ pub struct TrainOptions {
     pub classical_rows: usize,
     /// Continue from the checkpoint in the output folder.
     pub resume: bool,
+    /// Matched protocol only: draw new training-input noise at this SNR (dB) every epoch
+    /// instead of reading the data set's one fixed noisy copy (validation and test keep it).
+    #[serde(default)]
+    pub fresh_noise_snr_db: Option<f64>,
 }
 
 impl Default for TrainOptions {
@@ -52,6 +56,7 @@ impl Default for TrainOptions {
             windows_per_epoch: None,
             classical_rows: 40_000,
             resume: false,
+            fresh_noise_snr_db: None,
         }
     }
 }
@@ -136,6 +141,18 @@ pub fn train(
             prep.val.len()
         )));
     }
+    let refresher = match opts.fresh_noise_snr_db {
+        Some(snr) if kind.architecture().is_some() => {
+            if spec.noise != NoiseProtocol::Matched {
+                return Err(Error::Domain(format!(
+                    "fresh noise every epoch needs the matched noise protocol (train and test at the same SNR), not {:?}",
+                    spec.noise
+                )));
+            }
+            Some(NoiseRefresher::new(ds, spec, &prep.input_stats, snr)?)
+        }
+        _ => None,
+    };
     let manifest = ds.dir.join("manifest.json");
     let identity = json!({
         "folder": ds.dir.display().to_string(),
@@ -172,6 +189,7 @@ pub fn train(
             let (net, summary) = train_network(
                 config.clone(),
                 &prep.train,
+                refresher.as_ref(),
                 &prep.val,
                 opts,
                 out,
@@ -231,9 +249,11 @@ pub fn train(
     Ok(model)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn train_network(
     config: NetConfig,
     train: &WindowSet,
+    refresher: Option<&NoiseRefresher>,
     val: &WindowSet,
     opts: &TrainOptions,
     out: &Path,
@@ -250,6 +270,7 @@ fn train_network(
             opts.batch,
             opts.lr,
             opts.windows_per_epoch,
+            opts.fresh_noise_snr_db,
         ))
         .expect("serialises")
         .as_bytes(),
@@ -315,6 +336,10 @@ fn train_network(
             order.truncate(cap.max(batch));
         }
         net.reseed_dropout(opts.seed ^ (epoch as u64).wrapping_mul(0x9E37_79B9));
+        let fresh = refresher.map(|r| {
+            train.with_inputs(r.draw(opts.seed.wrapping_mul(7_919).wrapping_add(epoch as u64)))
+        });
+        let train = fresh.as_ref().unwrap_or(train);
         let batches = order.len().div_ceil(batch);
         let mut loss_sum = 0.0f64;
         for (bi, chunk) in order.chunks(batch).enumerate() {

@@ -89,6 +89,13 @@ impl WindowSet {
         (x, y)
     }
 
+    /// The same windows reading other (equally standardised) inputs, as
+    /// [`NoiseRefresher::draw`] makes them.
+    pub fn with_inputs(&self, x: Arc<Vec<Vec<f32>>>) -> WindowSet {
+        assert_eq!(x.len(), self.x.len(), "one input matrix per run");
+        WindowSet { x, ..self.clone() }
+    }
+
     /// Row (time step) of window `i`'s label in its run.
     pub fn label_row(&self, i: usize) -> (usize, usize) {
         let w = self.windows[i];
@@ -199,6 +206,86 @@ pub fn prepare(
         input_stats,
         target_stats,
     })
+}
+
+/// Fresh input noise for the training windows, one draw per epoch (matched protocol): the
+/// clean inputs plus white Gaussian noise with `σ_c = rms_c · 10^(−SNR/20)` per run and
+/// channel, exactly the data set's noise model (spec learning.md §1.4), in the training
+/// view's standardisation. A network trained on one fixed noise realisation learns that
+/// realisation (the training loss keeps falling while the validation loss stalls); a new
+/// draw every epoch leaves it only the signal. Validation and test keep the data set's
+/// fixed, seeded noise.
+#[derive(Debug, Clone)]
+pub struct NoiseRefresher {
+    /// Per run, standardised clean inputs `[rows × C]`.
+    clean: Vec<Vec<f32>>,
+    /// Per run and channel, the noise σ in standardised units.
+    sigma: Vec<Vec<f32>>,
+}
+
+impl NoiseRefresher {
+    /// Noise at `snr_db` for the inputs of `spec` with the training statistics `stats`.
+    pub fn new(ds: &DataSet, spec: &DataSpec, stats: &ZScore, snr_db: f64) -> Result<Self> {
+        if !snr_db.is_finite() {
+            return Err(Error::Domain(format!(
+                "the SNR of fresh noise must be finite, got {snr_db}"
+            )));
+        }
+        let cols = spec
+            .channels
+            .iter()
+            .map(|c| ds.channel(c))
+            .collect::<Result<Vec<_>>>()?;
+        let factor = 10f64.powf(-snr_db / 20.0);
+        let clean = ds
+            .runs
+            .iter()
+            .map(|r| interleave(r, &cols, stats))
+            .collect();
+        let sigma = ds
+            .runs
+            .iter()
+            .map(|r| {
+                cols.iter()
+                    .enumerate()
+                    .map(|(k, &c)| {
+                        let v = &r.columns[c];
+                        let rms =
+                            (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+                        (rms * factor / stats.std[k]) as f32
+                    })
+                    .collect()
+            })
+            .collect();
+        Ok(NoiseRefresher { clean, sigma })
+    }
+
+    /// A new noisy copy of the inputs, determined by `seed`.
+    pub fn draw(&self, seed: u64) -> Arc<Vec<Vec<f32>>> {
+        use rand_chacha::ChaCha8Rng;
+        use rand_chacha::rand_core::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        Arc::new(
+            self.clean
+                .iter()
+                .zip(&self.sigma)
+                .enumerate()
+                .map(|(r, (x, sig))| {
+                    let mut rng = ChaCha8Rng::seed_from_u64(
+                        seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ r as u64,
+                    );
+                    let mut out = Vec::with_capacity(x.len());
+                    for row in x.chunks_exact(sig.len()) {
+                        for (v, s) in row.iter().zip(sig) {
+                            let n: f32 = StandardNormal.sample(&mut rng);
+                            out.push(v + s * n);
+                        }
+                    }
+                    out
+                })
+                .collect(),
+        )
+    }
 }
 
 /// A run's columns standardised and interleaved row-major.
