@@ -118,12 +118,18 @@ pub fn file_hash(path: &Path) -> Result<String> {
     Ok(fnv1a(&std::fs::read(path).map_err(|e| Error::io(path, e))?))
 }
 
+/// Noise standard deviation of a clean channel at `snr_db`: `σ = rms · 10^(−SNR/20)`, the
+/// rms of the clean channel (spec learning.md §1.4).
+pub fn noise_sigma(clean: &[f64], snr_db: f64) -> f64 {
+    let rms = (clean.iter().map(|x| x * x).sum::<f64>() / clean.len().max(1) as f64).sqrt();
+    rms * 10f64.powf(-snr_db / 20.0)
+}
+
 /// Noise per input channel (spec learning.md §1.4): white Gaussian, `σ_c = rms_c·10^(−SNR/20)`
 /// with `rms_c` the RMS of the clean channel over the run; seeded by the run's seed and the
 /// channel's position, so the same run gives the same noise.
 pub fn noise_column(clean: &[f64], snr_db: f64, seed: u64, channel: usize) -> Vec<f64> {
-    let rms = (clean.iter().map(|x| x * x).sum::<f64>() / clean.len().max(1) as f64).sqrt();
-    let sigma = rms * 10f64.powf(-snr_db / 20.0);
+    let sigma = noise_sigma(clean, snr_db);
     let mut rng =
         ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ channel as u64);
     match Normal::new(0.0, sigma) {

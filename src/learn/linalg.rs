@@ -168,32 +168,42 @@ pub fn sigmoid(x: f32) -> f32 {
     1.0 / (1.0 + fast_exp(-x))
 }
 
+/// Saturation bound of [`fast_exp`]'s argument.
+pub(crate) const EXP_LIMIT: f32 = 87.0;
+/// 1.5·2^23: adding it rounds to an integer held in the low mantissa bits.
+pub(crate) const EXP_ROUND: f32 = 12_582_912.0;
+/// ln 2 split for the Cody–Waite reduction (high part exact in a few bits).
+pub(crate) const LN2_HI: f32 = 0.693_359_4;
+/// Low part of ln 2.
+pub(crate) const LN2_LO: f32 = -2.121_944_4e-4;
+/// Horner coefficients of `(e^r − 1 − r)/r²` on |r| ≤ ln2/2, highest degree first (Cephes).
+pub(crate) const EXP_POLY: [f32; 6] = [
+    1.987_569_1e-4,
+    1.398_199_9e-3,
+    8.333_452e-3,
+    4.166_579_6e-2,
+    1.666_666_5e-1,
+    0.5,
+];
+
 /// `e^x` to about 2 ulp for |x| < 87 (saturating beyond), branch-free so loops over slices
 /// vectorise: `e^x = 2^n·e^r`, `n = round(x/ln 2)`, `r = x − n·ln 2` (Cody–Waite split), and a
 /// degree-6 Taylor polynomial for `e^r` on |r| ≤ ln2/2 (Cephes `expf`). The recurrent cells
 /// spend most of their time in exp: libm's call per element is several times slower.
 #[inline(always)]
 pub fn fast_exp(x: f32) -> f32 {
-    const LOG2E: f32 = std::f32::consts::LOG2_E;
-    const LN2_HI: f32 = 0.693_359_4;
-    const LN2_LO: f32 = -2.121_944_4e-4;
-    let x = x.clamp(-87.0, 87.0);
+    let x = x.clamp(-EXP_LIMIT, EXP_LIMIT);
     // Round to nearest by the 1.5·2^23 trick (vectorises, unlike f32::round): the sum's low
     // mantissa bits are n itself, so 2^n is built with integer arithmetic only (a float →
     // int `as` cast saturates and does not vectorise).
-    let shifted = x * LOG2E + 12_582_912.0;
-    let n = shifted - 12_582_912.0;
+    let shifted = x * std::f32::consts::LOG2_E + EXP_ROUND;
+    let n = shifted - EXP_ROUND;
     let r = x - n * LN2_HI - n * LN2_LO;
-    let p = 1.987_569_1e-4;
-    let p = p * r + 1.398_199_9e-3;
-    let p = p * r + 8.333_452e-3;
-    let p = p * r + 4.166_579_6e-2;
-    let p = p * r + 1.666_666_5e-1;
-    let p = p * r + 0.5;
+    let p = EXP_POLY[1..].iter().fold(EXP_POLY[0], |p, &c| p * r + c);
     let e = p * r * r + r + 1.0;
     let two_n = (shifted
         .to_bits()
-        .wrapping_sub(0x4B40_0000)
+        .wrapping_sub(EXP_ROUND.to_bits())
         .wrapping_add(127))
         << 23;
     e * f32::from_bits(two_n)

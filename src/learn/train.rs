@@ -160,9 +160,7 @@ pub fn train(
         "runs": ds.runs.len(),
         "seeds": ds.runs.iter().map(|r| r.seed).collect::<std::collections::BTreeSet<_>>(),
         "conditions": ds.runs.iter().map(|r| r.condition.clone()).collect::<std::collections::BTreeSet<_>>(),
-        "snr_db": crate::io::read_text(&manifest).ok()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-            .and_then(|m| m["snr_db"].as_f64()),
+        "snr_db": ds.snr_db(),
     });
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let mut meta = ModelMeta {

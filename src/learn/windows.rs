@@ -236,7 +236,6 @@ impl NoiseRefresher {
             .iter()
             .map(|c| ds.channel(c))
             .collect::<Result<Vec<_>>>()?;
-        let factor = 10f64.powf(-snr_db / 20.0);
         let clean = ds
             .runs
             .iter()
@@ -249,10 +248,7 @@ impl NoiseRefresher {
                 cols.iter()
                     .enumerate()
                     .map(|(k, &c)| {
-                        let v = &r.columns[c];
-                        let rms =
-                            (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
-                        (rms * factor / stats.std[k]) as f32
+                        (crate::dataset::noise_sigma(&r.columns[c], snr_db) / stats.std[k]) as f32
                     })
                     .collect()
             })

@@ -142,7 +142,7 @@ impl BiLstm {
     /// fused ([`Recurrence`]), the state held in registers. Same numbers as [`BiLstm::forward`]
     /// up to rounding.
     pub fn forward_eval(
-        &self,
+        &mut self,
         p: &ParamSet,
         x: &[f32],
         batch: usize,
@@ -154,8 +154,7 @@ impl BiLstm {
         if h != H {
             // The fused kernel is compiled for the networks' width; others take the
             // training path (same numbers, with caches).
-            let mut copy = self.clone();
-            copy.forward(p, x, batch, steps, out);
+            self.forward(p, x, batch, steps, out);
             return;
         }
         let bias: Vec<f32> = p.value[self.b_ih.clone()]
@@ -421,31 +420,26 @@ impl Recurrence {
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::{H, HP};
+    use crate::learn::linalg::{EXP_LIMIT, EXP_POLY, EXP_ROUND, LN2_HI, LN2_LO};
     use std::arch::x86_64::*;
 
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn exp(x: __m256) -> __m256 {
         let x = _mm256_min_ps(
-            _mm256_max_ps(x, _mm256_set1_ps(-87.0)),
-            _mm256_set1_ps(87.0),
+            _mm256_max_ps(x, _mm256_set1_ps(-EXP_LIMIT)),
+            _mm256_set1_ps(EXP_LIMIT),
         );
         let shifted = _mm256_fmadd_ps(
             x,
             _mm256_set1_ps(std::f32::consts::LOG2_E),
-            _mm256_set1_ps(12_582_912.0),
+            _mm256_set1_ps(EXP_ROUND),
         );
-        let n = _mm256_sub_ps(shifted, _mm256_set1_ps(12_582_912.0));
-        let r = _mm256_fnmadd_ps(n, _mm256_set1_ps(0.693_359_4), x);
-        let r = _mm256_fnmadd_ps(n, _mm256_set1_ps(-2.121_944_4e-4), r);
-        let mut p = _mm256_set1_ps(1.987_569_1e-4);
-        for c in [
-            1.398_199_9e-3,
-            8.333_452e-3,
-            4.166_579_6e-2,
-            1.666_666_5e-1,
-            0.5,
-        ] {
+        let n = _mm256_sub_ps(shifted, _mm256_set1_ps(EXP_ROUND));
+        let r = _mm256_fnmadd_ps(n, _mm256_set1_ps(LN2_HI), x);
+        let r = _mm256_fnmadd_ps(n, _mm256_set1_ps(LN2_LO), r);
+        let mut p = _mm256_set1_ps(EXP_POLY[0]);
+        for &c in &EXP_POLY[1..] {
             p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(c));
         }
         let e = _mm256_fmadd_ps(
@@ -456,7 +450,7 @@ mod avx2 {
         // 2^n from the low mantissa bits of `shifted` (see `fast_exp`).
         let bits = _mm256_add_epi32(
             _mm256_castps_si256(shifted),
-            _mm256_set1_epi32(127 - 0x4B40_0000),
+            _mm256_set1_epi32(127 - EXP_ROUND.to_bits() as i32),
         );
         _mm256_mul_ps(e, _mm256_castsi256_ps(_mm256_slli_epi32::<23>(bits)))
     }
