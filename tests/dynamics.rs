@@ -231,6 +231,20 @@ fn bad_vehicle_files_name_file_and_element() {
             ),
             "contact.creep_law",
         ),
+        (
+            write_vehicle(
+                "accelerometers",
+                |t| {
+                    t.replacen(
+                        "accelerometers = \"specific-force\"",
+                        "accelerometers = \"piezo\"",
+                        1,
+                    )
+                },
+                id,
+            ),
+            "accelerometers",
+        ),
     ];
     for (path, want) in cases {
         let e = Vehicle::load(&path).unwrap_err().to_string();
@@ -239,6 +253,57 @@ fn bad_vehicle_files_name_file_and_element() {
             e.contains("c80.toml") || e.contains("c80.urdf"),
             "no file named: {e}"
         );
+    }
+}
+
+/// The two accelerometer readings differ by gravity only: the same motion (the sensor model
+/// does not touch the dynamics), and at every row and body the vector between the specific
+/// force and the kinematic acceleration is g in length, pointing up in a level body.
+#[test]
+fn accelerometers_read_specific_force_or_kinematic_acceleration() {
+    use railforce::vehicle::Accelerometers;
+    let track = Track::new(
+        TrackSpec::load(&root().join("tracks/tangent.toml")).unwrap(),
+        Some(2),
+    );
+    let record = |a: Accelerometers| {
+        let mut v = c80().clone();
+        v.accelerometers = a;
+        let cfg = SimConfig {
+            speed: 60.0 / 3.6,
+            duration: 0.2,
+            settle: 0.2,
+            ..SimConfig::default()
+        };
+        let mut sim = Simulation::new(&v, &track, cfg).unwrap();
+        output::record(&mut sim, |_| {}).unwrap()
+    };
+    assert_eq!(c80().accelerometers, Accelerometers::SpecificForce);
+    let (sf, kin) = (
+        record(Accelerometers::SpecificForce),
+        record(Accelerometers::Kinematic),
+    );
+    assert_eq!(sf.names, kin.names);
+    let col = |n: &str| sf.names.iter().position(|c| c == n).unwrap();
+    for (i, name) in sf.names.iter().enumerate() {
+        if !name.contains("acc_") {
+            for (a, b) in sf.rows.iter().zip(&kin.rows) {
+                assert_eq!(a[i], b[i], "{name} depends on the accelerometer model");
+            }
+        }
+    }
+    for b in &c80().bodies {
+        let c = [
+            col(&format!("{}_acc_x", b.name)),
+            col(&format!("{}_acc_y", b.name)),
+            col(&format!("{}_acc_z", b.name)),
+        ];
+        for (a, k) in sf.rows.iter().zip(&kin.rows) {
+            let d: Vec<f64> = c.iter().map(|&i| a[i] - k[i]).collect();
+            let norm = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+            assert!((norm / railforce::GRAVITY - 1.0).abs() < 1e-3, "{}", b.name);
+            assert!(d[2] > 0.999 * railforce::GRAVITY, "{} reads g up", b.name);
+        }
     }
 }
 

@@ -48,6 +48,7 @@ fn every_experiment_runs_end_to_end() {
         robustness_models: vec![ModelKind::Tree, ModelKind::Gru],
         snrs: vec![40.0, 1.0],
         loco: vec!["curve_r400_v60".into()],
+        window: 12,
         train: TrainOptions {
             epochs: 2,
             patience: 2,
@@ -119,4 +120,6 @@ fn every_experiment_runs_end_to_end() {
     assert!(
         meta["data_manifest_fnv1a"].is_string() && meta["wall_seconds"].as_f64().unwrap() > 0.0
     );
+    assert_eq!(meta["window"], 12);
+    assert!(html.contains("windows of 12 steps"));
 }

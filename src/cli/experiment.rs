@@ -56,6 +56,10 @@ pub struct ExperimentArgs {
     /// last (causal, usable on board in real time).
     #[arg(long)]
     centre_label: bool,
+    /// Window length, steps (the paper's 20 at 200 Hz = 0.1 s; longer windows average more
+    /// noise out and cost proportionally more time).
+    #[arg(long, default_value_t = 20)]
+    window: usize,
     /// Train the networks on the one fixed noisy copy of the inputs instead of drawing new
     /// noise every epoch (the default draws fresh noise at the same SNR; validation and test
     /// keep their fixed noise either way).
@@ -88,6 +92,7 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
     opts.snr_db = args.snr_db;
     opts.jobs = args.jobs;
     opts.fresh_noise = !args.fixed_noise;
+    opts.window = args.window;
     if args.centre_label {
         opts.label_at = railforce::features::LabelAt::Centre;
     }

@@ -73,7 +73,8 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         "anti_alias": format!("4th-order Butterworth low-pass at {} Hz at the integration rate, then decimation", sim.config().cutoff),
         "frame": "track frame: x along the running direction, y to the left, z up",
         "forces": "forces of the rail on the wheel in the track frame: force_y = Y (+ left), force_z = Q (+ up); wheels 1L..4R numbered from the front, left/right facing the running direction",
-        "accelerations": "accelerometer reading (specific force a - g, so +9.81 m/s2 vertically at rest), body axes; wheelsets in the local track axes (axle-box sensor)",
+        "accelerations": vehicle.accelerometers.describe(),
+        "accelerometers": vehicle.accelerometers.name(),
         "labels": {"FL": "w1l_force_y", "FQ": "w1l_force_z"},
         "conventions_note": "EN names: Y lateral, Q vertical (Chinese standards: Q lateral, P vertical)",
     });

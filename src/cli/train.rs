@@ -43,6 +43,9 @@ pub struct DataArgs {
     /// selection's (or the last step).
     #[arg(long)]
     pub centre_label: bool,
+    /// Window length, steps, instead of the selection's (or 20).
+    #[arg(long)]
+    pub window: Option<usize>,
 }
 
 #[derive(Debug, Args)]
@@ -102,6 +105,7 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
             LabelAt::Last,
         ),
     };
+    let window = args.window.unwrap_or(window);
     let label_at = if args.centre_label {
         LabelAt::Centre
     } else {

@@ -60,6 +60,8 @@ pub struct ExperimentOptions {
     pub jobs: usize,
     /// Label position (the last step: causal, the default; the centre: as the paper reads).
     pub label_at: LabelAt,
+    /// Window length, steps (the paper's 20 by default).
+    pub window: usize,
     /// Networks trained at an SNR (matched protocol) draw new training-input noise every
     /// epoch instead of learning one fixed realisation (validation and test keep theirs).
     pub fresh_noise: bool,
@@ -90,6 +92,7 @@ impl ExperimentOptions {
             },
             jobs: 2,
             label_at: LabelAt::Last,
+            window: 20,
             fresh_noise: true,
         }
     }
@@ -161,12 +164,12 @@ fn subset(ds: &DataSet, conditions: &[String]) -> DataSet {
     }
 }
 
-fn spec(label_at: LabelAt, noise: NoiseProtocol, split: Split) -> DataSpec {
+fn spec(opts: &ExperimentOptions, noise: NoiseProtocol, split: Split) -> DataSpec {
     DataSpec {
         channels: PAPER_CHANNELS.iter().map(|c| c.to_string()).collect(),
         targets: vec!["w1l_force_y".into(), "w1l_force_z".into()],
-        window: 20,
-        label_at,
+        window: opts.window,
+        label_at: opts.label_at,
         stride: 1,
         split,
         noise,
@@ -306,11 +309,12 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
         "condition": opts.condition,
         "training": opts.train,
         "label_at": format!("{:?}", opts.label_at),
+        "window": opts.window,
         "fresh_noise_every_epoch": opts.fresh_noise,
         "railforce_version": env!("CARGO_PKG_VERSION"),
         "wall_seconds": wall,
         "timings": timings,
-        "protocol": "70/15/15 % contiguous blocks per run (or whole conditions held out), z-scores from training blocks, window 20 × 21 channels, FL and FQ as two outputs of one model",
+        "protocol": "70/15/15 % contiguous blocks per run (or whole conditions held out), z-scores from training blocks, window × 21 channels (window in \"window\"), FL and FQ as two outputs of one model",
     });
     let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");
     crate::io::write_atomic(&opts.out.join("meta.json"), |w| w.write_all(mj.as_bytes()))?;
@@ -325,7 +329,8 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
             wall
         ),
         format!(
-            "Protocol: each run cut into contiguous 70/15/15 % train/validation/test blocks before windowing (no window crosses a block), z-scores from the training blocks only, windows of 20 steps × 21 channels, label at the {} step, FL (w1l_force_y) and FQ (w1l_force_z) as the two outputs of one model. MSE and R² on standardised targets; Var(y_test) shown beside them. Paper numbers come from another simulator and unknown splits: a bar, not a target to match digit for digit.",
+            "Protocol: each run cut into contiguous 70/15/15 % train/validation/test blocks before windowing (no window crosses a block), z-scores from the training blocks only, windows of {} steps × 21 channels, label at the {} step, FL (w1l_force_y) and FQ (w1l_force_z) as the two outputs of one model. MSE and R² on standardised targets; Var(y_test) shown beside them. Paper numbers come from another simulator and unknown splits: a bar, not a target to match digit for digit.",
+            opts.window,
             if opts.label_at == LabelAt::Last {
                 "last (causal)"
             } else {
@@ -365,7 +370,7 @@ fn comparison(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
         &subset(ds, std::slice::from_ref(&opts.condition)),
         opts.snr_db,
     );
-    let sp = spec(opts.label_at, NoiseProtocol::Matched, Split::default());
+    let sp = spec(opts, NoiseProtocol::Matched, Split::default());
     let dir = opts.out.join("comparison");
     let mut tables: [Table; 2] = std::array::from_fn(|_| {
         Table::new(&[
@@ -531,7 +536,7 @@ fn generalization(ctx: &mut Ctx, ds: &DataSet, conditions: &[String]) -> Result<
     let dir = opts.out.join("generalization");
     let (mut model, secs) = ctx.fit(
         &dsn,
-        &spec(opts.label_at, NoiseProtocol::Matched, Split::default()),
+        &spec(opts, NoiseProtocol::Matched, Split::default()),
         ModelKind::CnnBiLstm,
         &dir.join("models/all_conditions"),
         Some(opts.snr_db),
@@ -606,7 +611,7 @@ fn generalization(ctx: &mut Ctx, ds: &DataSet, conditions: &[String]) -> Result<
             ));
         }
         let sp = spec(
-            opts.label_at,
+            opts,
             NoiseProtocol::Matched,
             Split::Conditions {
                 val: vec![val.clone()],
@@ -691,7 +696,7 @@ fn robustness(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
             let clean_model = if proto == NoiseProtocol::TrainCleanTestNoisy {
                 let (mut m, _) = ctx.fit(
                     &base,
-                    &spec(opts.label_at, NoiseProtocol::Clean, Split::default()),
+                    &spec(opts, NoiseProtocol::Clean, Split::default()),
                     kind,
                     &dir.join(format!("models/clean_{}", kind.name())),
                     None,
@@ -709,7 +714,7 @@ fn robustness(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
                     None => {
                         let (mut m, _) = ctx.fit(
                             &dsn,
-                            &spec(opts.label_at, NoiseProtocol::Matched, Split::default()),
+                            &spec(opts, NoiseProtocol::Matched, Split::default()),
                             kind,
                             &dir.join(format!("models/matched_{}_{snr}dB", kind.name())),
                             Some(snr),

@@ -3,13 +3,16 @@
 //! decimated to the output rate, streamed to a CSV file written atomically, with a metadata
 //! file beside it.
 //!
-//! Accelerations are what an accelerometer on the body reads: specific force `a − g` (so a body
-//! at rest reads +g vertically), in body axes; for wheelsets, which spin, in the axes of the
-//! local track frame (an axle-box accelerometer).
+//! Accelerations are what the vehicle file's accelerometers read ([`Accelerometers`]): the
+//! kinematic acceleration `a` (default) or the specific force `a − g`, in body axes; for
+//! wheelsets, which spin, in the axes of the local track frame (an axle-box accelerometer).
+//!
+//! [`Accelerometers`]: crate::vehicle::Accelerometers
 
 use super::filter::Lowpass;
 use super::{Simulation, wheel_name};
 use crate::error::{Error, Result};
+use crate::vehicle::Accelerometers;
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -152,7 +155,11 @@ impl Recorder {
 fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
     let v = sim.vehicle();
     let states = sim.states();
-    let g = Vector3::new(0.0, 0.0, crate::GRAVITY);
+    // World z is up: a body at rest has a = 0 and reads a − g = +g·e_z as specific force.
+    let g = match v.accelerometers {
+        Accelerometers::Kinematic => Vector3::zeros(),
+        Accelerometers::SpecificForce => Vector3::new(0.0, 0.0, crate::GRAVITY),
+    };
     let mut body_vals: Vec<[f64; 10]> = Vec::with_capacity(states.len());
     for (i, st) in states.iter().enumerate() {
         let f = &sim.frames()[i];

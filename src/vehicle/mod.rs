@@ -37,6 +37,7 @@ struct VehicleFile {
     track_spring: Vec<TrackSpringFile>,
     hauling: Option<HaulingFile>,
     sensors: Option<SensorsFile>,
+    accelerometers: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -204,6 +205,51 @@ pub struct Hauling {
     pub integral: f64,
 }
 
+/// What the virtual accelerometers read (spec physics.md §5 lets either be chosen, once).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Accelerometers {
+    /// Specific force `a − g` in body axes (what a DC accelerometer reads): +9.81 m/s²
+    /// vertically at rest; laterally on a canted curve, the uncompensated acceleration that
+    /// drives the quasi-static load transfer between the wheels. The default.
+    #[default]
+    SpecificForce,
+    /// Kinematic acceleration `a` in body axes, gravity excluded (a multibody code's
+    /// acceleration output): 0 at rest. Loses the body's tilt against gravity, hence the
+    /// load transfer (README, "Virtual sensors").
+    Kinematic,
+}
+
+impl Accelerometers {
+    /// Parses the vehicle file's spelling: `kinematic` or `specific-force`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "kinematic" => Some(Self::Kinematic),
+            "specific-force" => Some(Self::SpecificForce),
+            _ => None,
+        }
+    }
+
+    /// The spelling of the vehicle file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Kinematic => "kinematic",
+            Self::SpecificForce => "specific-force",
+        }
+    }
+
+    /// One sentence for metadata files.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Kinematic => {
+                "kinematic acceleration a, gravity excluded (0 at rest), body axes; wheelsets in the local track axes (axle-box sensor)"
+            }
+            Self::SpecificForce => {
+                "specific force a - g (+9.81 m/s2 vertically at rest), body axes; wheelsets in the local track axes (axle-box sensor)"
+            }
+        }
+    }
+}
+
 /// Bodies that carry the paper's sensors.
 #[derive(Debug, Clone)]
 pub struct SensorLayout {
@@ -238,6 +284,8 @@ pub struct Vehicle {
     pub hauling: Option<Hauling>,
     /// Sensor layout (None for models without the paper's bogie, e.g. a single wheelset).
     pub sensors: Option<SensorLayout>,
+    /// What every recorded acceleration is.
+    pub accelerometers: Accelerometers,
 }
 
 impl Vehicle {
@@ -476,6 +524,15 @@ impl Vehicle {
                 ),
             )
         })?;
+        let accelerometers = match &raw.accelerometers {
+            None => Accelerometers::default(),
+            Some(a) => Accelerometers::parse(a).ok_or_else(|| {
+                cfg(
+                    "accelerometers".into(),
+                    format!("unknown reading \"{a}\": use kinematic or specific-force"),
+                )
+            })?,
+        };
         let resolve = |spec: &str| -> String {
             if Path::new(spec).extension().is_some() {
                 dir.join(spec).to_string_lossy().into_owned()
@@ -569,6 +626,7 @@ impl Vehicle {
             },
             hauling,
             sensors,
+            accelerometers,
         };
         vehicle.distribute_static_load(path)?;
         // Wedges read the nest's static compression.
