@@ -314,7 +314,7 @@ pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) 
         "railforce_version": env!("CARGO_PKG_VERSION"),
         "wall_seconds": wall,
         "timings": timings,
-        "protocol": "70/15/15 % contiguous blocks per run (or whole conditions held out), z-scores from training blocks, window × 21 channels (window in \"window\"), FL and FQ as two outputs of one model",
+        "protocol": format!("70/15/15 % contiguous blocks per run (or whole conditions held out), z-scores from training blocks, window {} × 21 channels, FL and FQ as two outputs of one model", opts.window),
     });
     let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");
     crate::io::write_atomic(&opts.out.join("meta.json"), |w| w.write_all(mj.as_bytes()))?;

@@ -4,7 +4,7 @@
 //! file beside it.
 //!
 //! Accelerations are what the vehicle file's accelerometers read ([`Accelerometers`]): the
-//! kinematic acceleration `a` (default) or the specific force `a − g`, in body axes; for
+//! specific force `a − g` (default) or the kinematic acceleration `a`, in body axes; for
 //! wheelsets, which spin, in the axes of the local track frame (an axle-box accelerometer).
 //!
 //! [`Accelerometers`]: crate::vehicle::Accelerometers

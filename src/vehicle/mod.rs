@@ -215,7 +215,7 @@ pub enum Accelerometers {
     SpecificForce,
     /// Kinematic acceleration `a` in body axes, gravity excluded (a multibody code's
     /// acceleration output): 0 at rest. Loses the body's tilt against gravity, hence the
-    /// load transfer (README, "Virtual sensors").
+    /// load transfer (README, "Vehicle files").
     Kinematic,
 }
 
