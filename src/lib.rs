@@ -20,6 +20,7 @@ pub mod io;
 pub mod learn;
 pub mod plan;
 pub mod report;
+pub mod sensors;
 pub mod sim;
 pub mod track;
 pub mod vehicle;

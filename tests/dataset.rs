@@ -1,5 +1,6 @@
 //! Data set generation: formats, resume, shards, noise, and loading from Python.
 
+use railforce::sensors::{NoiseModel, SnrReference};
 use railforce::dataset::{self, Event, Format, GenerateOptions, npz};
 use railforce::plan::Plan;
 use std::path::{Path, PathBuf};
@@ -38,7 +39,7 @@ fn opts(out: &Path, format: Format, shard: Option<(usize, usize)>) -> GenerateOp
         format,
         jobs: 2,
         shard,
-        snr_db: Some(6.0),
+        noise: Some(NoiseModel::new(6.0, SnrReference::Std)),
         settle: 0.2,
     }
 }
@@ -212,23 +213,34 @@ fn python_loads(npz_file: &Path, parquet_file: &Path, n_channels: usize) {
 
 #[test]
 fn noise_has_the_stated_variance_and_is_seeded() {
-    let clean: Vec<f64> = (0..40_000).map(|i| (i as f64 * 0.01).sin() * 3.0).collect();
+    // An offset, as gravity in a vertical accelerometer: the rms reference sees it, the std
+    // reference (the default) does not.
+    let clean: Vec<f64> = (0..40_000)
+        .map(|i| (i as f64 * 0.01).sin() * 3.0 + 9.81)
+        .collect();
     let rms = (clean.iter().map(|x| x * x).sum::<f64>() / clean.len() as f64).sqrt();
-    for snr in [0.0, 6.0, 20.0] {
-        let noisy = dataset::noise_column(&clean, snr, 7, 3);
+    let std = 3.0 / 2f64.sqrt();
+    for (snr, reference, scale) in [
+        (0.0, SnrReference::Std, std),
+        (6.0, SnrReference::Std, std),
+        (20.0, SnrReference::Std, std),
+        (6.0, SnrReference::Rms, rms),
+    ] {
+        let m = NoiseModel::new(snr, reference);
+        let noisy = m.apply(&clean, 7, "ws1_acc_z");
         let var = noisy
             .iter()
             .zip(&clean)
             .map(|(a, b)| (a - b).powi(2))
             .sum::<f64>()
             / clean.len() as f64;
-        let want = (rms * 10f64.powf(-snr / 20.0)).powi(2);
+        let want = (scale * 10f64.powf(-snr / 20.0)).powi(2);
         assert!(
             (var / want - 1.0).abs() < 0.03,
             "SNR {snr}: {var} vs {want}"
         );
-        assert_eq!(noisy, dataset::noise_column(&clean, snr, 7, 3));
-        assert_ne!(noisy, dataset::noise_column(&clean, snr, 8, 3));
+        assert_eq!(noisy, m.apply(&clean, 7, "ws1_acc_z"));
+        assert_ne!(noisy, m.apply(&clean, 8, "ws1_acc_z"));
     }
 }
 

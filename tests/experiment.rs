@@ -56,7 +56,7 @@ fn every_experiment_runs_end_to_end() {
         },
         ..ExperimentOptions::full(tiny_plan(&dir), dir.join("out"))
     };
-    let index = run(Which::All, &opts, &mut |_| {}).unwrap();
+    let index = run(&[Which::All], &opts, &mut |_| {}).unwrap();
     let out = dir.join("out");
     let header = |p: &str| {
         std::fs::read_to_string(out.join(p))
@@ -108,9 +108,9 @@ fn every_experiment_runs_end_to_end() {
     }
     assert!(links >= 12, "{links} links");
     for svg in [
-        "comparison/training_curves.svg",
+        "comparison/training_curves_fl.svg",
         "comparison/trace_fq.svg",
-        "robustness/r2_vs_snr_matched.svg",
+        "robustness/r2_vs_snr_fq_matched.svg",
     ] {
         let s = std::fs::read_to_string(out.join(svg)).unwrap();
         assert!(s.starts_with("<svg") && s.contains("polyline"), "{svg}");
@@ -121,5 +121,15 @@ fn every_experiment_runs_end_to_end() {
         meta["data_manifest_fnv1a"].is_string() && meta["wall_seconds"].as_f64().unwrap() > 0.0
     );
     assert_eq!(meta["window"], 12);
+    assert_eq!(meta["label_at"], "Centre");
+    assert_eq!(meta["noise"]["reference"], "std");
+    let protocols = std::fs::read_to_string(out.join("protocols/protocols.csv")).unwrap();
+    assert!(protocols.starts_with("protocol,"), "{protocols}");
+    assert!(protocols.contains("shuffled (leaky)") && protocols.contains("SHUFFLED (leaky)"));
+    assert_eq!(protocols.lines().count(), 5);
+    let sensors = std::fs::read_to_string(out.join("sensors/sensors.csv")).unwrap();
+    assert!(sensors.contains("selected on-board") && sensors.contains("paper's 21"));
+    assert!(header("sensors/selection_fq.csv").starts_with("channel,MI nats"));
+    assert!(html.contains("label at the centre step"));
     assert!(html.contains("windows of 12 steps"));
 }

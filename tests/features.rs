@@ -4,7 +4,7 @@
 use railforce::features::{
     self, DataSet, LabelAt, NoiseProtocol, Part, Run, SelectOptions, Split, ZScore,
 };
-use railforce::sim::output::PAPER_CHANNELS;
+use railforce::sensors::PAPER_CHANNELS;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -33,11 +33,7 @@ fn synthetic(runs: usize, n: usize) -> DataSet {
             }
         })
         .collect();
-    DataSet {
-        dir: "synthetic".into(),
-        names,
-        runs,
-    }
+    DataSet::in_memory(std::path::Path::new("synthetic"), names, runs)
 }
 
 #[test]

@@ -24,11 +24,7 @@ fn synthetic(rows: usize) -> DataSet {
         seed: 1,
         columns: vec![time, a, b, y],
     };
-    DataSet {
-        dir: PathBuf::from("synthetic"),
-        names,
-        runs: vec![run],
-    }
+    DataSet::in_memory(&PathBuf::from("synthetic"), names, vec![run])
 }
 
 fn model(label_at: LabelAt, test: &str) -> (DataSet, Model) {
@@ -41,6 +37,7 @@ fn model(label_at: LabelAt, test: &str) -> (DataSet, Model) {
         stride: 1,
         split: Split::default(),
         noise: NoiseProtocol::Clean,
+        noise_model: None,
     };
     let out = std::env::temp_dir().join(format!(
         "railforce-identify-{}-{test}-{label_at:?}",

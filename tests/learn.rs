@@ -1,5 +1,6 @@
 //! Trainer, model directories and classical regressors on small synthetic problems.
 
+use railforce::sensors::{NoiseModel, SnrReference};
 use railforce::features::{DataSet, LabelAt, NoiseProtocol, Run, Split};
 use railforce::learn::classical::{Classical, ClassicalParams};
 use railforce::learn::evaluate::{EvalPart, evaluate};
@@ -48,11 +49,7 @@ fn synthetic(runs: usize, rows: usize) -> DataSet {
             }
         })
         .collect();
-    DataSet {
-        dir: PathBuf::from("synthetic"),
-        names,
-        runs,
-    }
+    DataSet::in_memory(&PathBuf::from("synthetic"), names, runs)
 }
 
 fn spec() -> DataSpec {
@@ -64,6 +61,7 @@ fn spec() -> DataSpec {
         stride: 1,
         split: Split::default(),
         noise: NoiseProtocol::Clean,
+        noise_model: None,
     }
 }
 
@@ -249,17 +247,10 @@ fn classical_models_learn_a_nonlinear_function() {
 }
 
 /// The synthetic set with `_noisy` copies of its inputs at `snr` dB (the data set's noise).
-fn with_noisy(mut ds: DataSet, snr: f64) -> DataSet {
-    let inputs = ["a", "b", "c"];
-    for run in &mut ds.runs {
-        for (k, name) in inputs.iter().enumerate() {
-            let c = ds.names.iter().position(|n| n == name).unwrap();
-            let noisy = railforce::dataset::noise_column(&run.columns[c], snr, run.seed, k);
-            run.columns.push(noisy);
-        }
-    }
-    ds.names.extend(inputs.iter().map(|n| format!("{n}_noisy")));
-    ds
+fn with_noisy(ds: DataSet, snr: f64) -> DataSet {
+    let inputs: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
+    ds.with_noise(NoiseModel::new(snr, SnrReference::Std), &inputs)
+        .unwrap()
 }
 
 #[test]
@@ -271,8 +262,9 @@ fn fresh_noise_has_the_data_sets_level_and_changes_with_the_seed() {
         ..spec()
     };
     let prep = prepare(&ds, &s, None).unwrap();
-    let clean = NoiseRefresher::new(&ds, &s, &prep.input_stats, 1000.0).unwrap();
-    let fresh = NoiseRefresher::new(&ds, &s, &prep.input_stats, 6.0).unwrap();
+    let at = |snr| NoiseModel::new(snr, SnrReference::Std);
+    let clean = NoiseRefresher::new(&ds, &s, &prep.input_stats, &at(1000.0)).unwrap();
+    let fresh = NoiseRefresher::new(&ds, &s, &prep.input_stats, &at(6.0)).unwrap();
     let (base, a, a2, b) = (clean.draw(1), fresh.draw(1), fresh.draw(1), fresh.draw(2));
     assert_eq!(a, a2, "same seed, same draw");
     assert_ne!(a, b, "another seed, another draw");
@@ -312,7 +304,7 @@ fn fresh_noise_has_the_data_sets_level_and_changes_with_the_seed() {
 fn fresh_noise_needs_the_matched_protocol() {
     let ds = with_noisy(synthetic(1, 400), 6.0);
     let opts = TrainOptions {
-        fresh_noise_snr_db: Some(6.0),
+        fresh_noise: Some(NoiseModel::new(6.0, SnrReference::Std)),
         ..quick(1)
     };
     let err = train(

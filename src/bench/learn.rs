@@ -151,7 +151,7 @@ pub fn streaming_latency_us(samples: usize) -> f64 {
     use crate::features::{LabelAt, NoiseProtocol, Split, ZScore};
     use crate::learn::model::{Engine, Model, ModelKind, ModelMeta};
     use crate::learn::windows::DataSpec;
-    let channels: Vec<String> = crate::sim::output::PAPER_CHANNELS
+    let channels: Vec<String> = crate::sensors::PAPER_CHANNELS
         .iter()
         .map(|c| c.to_string())
         .collect();
@@ -180,6 +180,7 @@ pub fn streaming_latency_us(samples: usize) -> f64 {
                 stride: 1,
                 split: Split::default(),
                 noise: NoiseProtocol::Clean,
+                noise_model: None,
             },
             input_stats: stats(channels),
             target_stats: stats(vec!["w1l_force_y".into(), "w1l_force_z".into()]),

@@ -5,7 +5,9 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use railforce::experiment::{self, ExperimentOptions, Which};
 use railforce::learn::model::ModelKind;
+use railforce::features::Split;
 use railforce::learn::train::TrainOptions;
+use railforce::sensors::SnrReference;
 use std::path::PathBuf;
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -16,15 +18,22 @@ pub enum WhichArg {
     Generalization,
     /// SNR sweep of GBDT, BiLSTM, CNN and CNN-BiLSTM under both noise protocols (Fig. 8).
     Robustness,
-    /// All three.
+    /// The CNN-BiLSTM under the seed, block, condition and shuffled splits, side by side.
+    Protocols,
+    /// Filter–Wrapper over the on-board candidates for FL and FQ; the CNN-BiLSTM on the
+    /// selected set against the paper's 21 at 6 and 1 dB.
+    Sensors,
+    /// The paper's three: comparison, generalization, robustness.
+    Paper,
+    /// All five.
     All,
 }
 
 #[derive(Debug, Args)]
 pub struct ExperimentArgs {
-    /// Which experiment.
-    #[arg(value_enum)]
-    which: WhichArg,
+    /// Which experiments, comma separated (e.g. `generalization,protocols`), in this order.
+    #[arg(value_enum, value_delimiter = ',', required = true)]
+    which: Vec<WhichArg>,
     /// Plan of conditions (simulated once, clean; noise is added per SNR).
     #[arg(long, default_value = "tracks/paper34.plan.toml")]
     plan: PathBuf,
@@ -34,9 +43,22 @@ pub struct ExperimentArgs {
     /// Condition of the comparison and robustness experiments.
     #[arg(long, default_value = "curve_r400_v60")]
     condition: String,
-    /// SNR of the comparison and generalisation, dB.
+    /// SNR of the comparison, generalisation, protocols and sensors, dB.
     #[arg(long, default_value_t = 6.0)]
     snr_db: f64,
+    /// What the SNR is measured against: `std` (each channel's variation, the default) or
+    /// `rms` (offset included, the former definition).
+    #[arg(long, default_value = "std", value_parser = ["std", "rms"])]
+    snr_reference: String,
+    /// Training seeds (comma separated) instead of all of the plan's but the last two.
+    #[arg(long, value_delimiter = ',')]
+    train_seeds: Vec<u64>,
+    /// Validation seeds instead of the plan's one before last.
+    #[arg(long, value_delimiter = ',')]
+    val_seeds: Vec<u64>,
+    /// Test seeds instead of the plan's last.
+    #[arg(long, value_delimiter = ',')]
+    test_seeds: Vec<u64>,
     /// Epochs at most per network.
     #[arg(long, default_value_t = 100)]
     epochs: usize,
@@ -52,10 +74,10 @@ pub struct ExperimentArgs {
     /// Simulations in parallel.
     #[arg(long, default_value_t = 2)]
     jobs: usize,
-    /// Label at the centre step of the window (non-causal, as the paper reads) instead of the
-    /// last (causal, usable on board in real time).
+    /// Label at the last step of the window (causal, usable on board in real time) instead of
+    /// the centre step (the paper's).
     #[arg(long)]
-    centre_label: bool,
+    last_label: bool,
     /// Window length, steps (the paper's 20 at 200 Hz = 0.1 s; longer windows average more
     /// noise out and cost proportionally more time).
     #[arg(long, default_value_t = 20)]
@@ -67,7 +89,7 @@ pub struct ExperimentArgs {
     fixed_noise: bool,
 }
 
-fn run_with(which: Which, opts: &ExperimentOptions) -> Result<()> {
+fn run_with(which: &[Which], opts: &ExperimentOptions) -> Result<()> {
     let t0 = std::time::Instant::now();
     let index = experiment::run(which, opts, &mut |line| {
         eprintln!("[{:>6.0} s] {line}", t0.elapsed().as_secs_f64())
@@ -81,29 +103,47 @@ fn run_with(which: Which, opts: &ExperimentOptions) -> Result<()> {
 }
 
 pub fn run(args: ExperimentArgs) -> Result<()> {
-    let which = match args.which {
-        WhichArg::Comparison => Which::Comparison,
-        WhichArg::Generalization => Which::Generalization,
-        WhichArg::Robustness => Which::Robustness,
-        WhichArg::All => Which::All,
-    };
+    let which: Vec<Which> = args
+        .which
+        .iter()
+        .map(|w| match w {
+            WhichArg::Comparison => Which::Comparison,
+            WhichArg::Generalization => Which::Generalization,
+            WhichArg::Robustness => Which::Robustness,
+            WhichArg::Protocols => Which::Protocols,
+            WhichArg::Sensors => Which::Sensors,
+            WhichArg::Paper => Which::Paper,
+            WhichArg::All => Which::All,
+        })
+        .collect();
     let mut opts = ExperimentOptions::full(args.plan, args.out);
     opts.condition = args.condition;
     opts.snr_db = args.snr_db;
     opts.jobs = args.jobs;
     opts.fresh_noise = !args.fixed_noise;
     opts.window = args.window;
-    if args.centre_label {
-        opts.label_at = railforce::features::LabelAt::Centre;
+    if args.last_label {
+        opts.label_at = railforce::features::LabelAt::Last;
+    }
+    opts.snr_reference = SnrReference::parse(&args.snr_reference).unwrap_or_default();
+    if !(args.train_seeds.is_empty() && args.val_seeds.is_empty() && args.test_seeds.is_empty()) {
+        if args.train_seeds.is_empty() || args.test_seeds.is_empty() {
+            anyhow::bail!("give --train-seeds and --test-seeds (and --val-seeds) together");
+        }
+        opts.split = Some(Split::Seeds {
+            train: args.train_seeds,
+            val: args.val_seeds,
+            test: args.test_seeds,
+        });
     }
     opts.train = TrainOptions {
         epochs: args.epochs,
         patience: args.patience,
         seed: args.seed,
         windows_per_epoch: (args.windows_per_epoch > 0).then_some(args.windows_per_epoch),
-        ..TrainOptions::default()
+        ..opts.train
     };
-    run_with(which, &opts)
+    run_with(&which, &opts)
 }
 
 #[derive(Debug, Args)]
@@ -116,18 +156,21 @@ pub struct DemoArgs {
     plan: PathBuf,
 }
 
-/// The demo's settings: three short runs, a CNN-BiLSTM and GBDT, four SNRs.
+/// The demo's settings: three short runs, a CNN-BiLSTM and GBDT, two SNRs.
 pub fn demo_options(plan: PathBuf, out: PathBuf) -> ExperimentOptions {
     ExperimentOptions {
         models: vec![ModelKind::CnnBiLstm, ModelKind::Gbdt],
         robustness_models: vec![ModelKind::Gbdt, ModelKind::CnnBiLstm],
-        snrs: vec![100.0, 20.0, 6.0, 1.0],
+        snrs: vec![20.0, 1.0],
         loco: vec!["curve_r400_v60".into()],
         train: TrainOptions {
-            epochs: 25,
-            patience: 8,
+            epochs: 15,
+            patience: 5,
+            windows_per_epoch: Some(10_000),
+            val_windows: Some(8_000),
             ..TrainOptions::default()
         },
+        condition_windows_per_epoch: 8_000,
         ..ExperimentOptions::full(plan, out)
     }
 }
@@ -137,7 +180,7 @@ pub fn demo(args: DemoArgs) -> Result<()> {
         eprintln!("warning: debug build; `cargo run --release -- demo` is many times faster");
     }
     eprintln!(
-        "railforce demo: simulate 3 short conditions, train a CNN-BiLSTM and GBDT, sweep 4 SNRs, write the report"
+        "railforce demo: simulate 3 short conditions, train a CNN-BiLSTM and GBDT, sweep 2 SNRs, write the report"
     );
-    run_with(Which::All, &demo_options(args.plan, args.out))
+    run_with(&[Which::Paper], &demo_options(args.plan, args.out))
 }

@@ -25,9 +25,15 @@ pub struct GenerateArgs {
     /// k mod N = i − 1; writes manifest.shard-i-of-N.json.
     #[arg(long, value_name = "i/N")]
     shard: Option<String>,
-    /// Add noised copies of the 21 input channels at this signal-to-noise ratio, dB.
+    /// Add noised copies (`<channel>_noisy`) of the 21 input channels at this signal-to-noise
+    /// ratio, dB: white Gaussian noise with σ = std(clean channel over the run)·10^(−SNR/20).
     #[arg(long, allow_hyphen_values = true)]
     snr_db: Option<f64>,
+    /// What the SNR is measured against: `std` (each channel's variation, the default; a
+    /// constant offset such as gravity sets no noise level) or `rms` (offset included, the
+    /// former definition).
+    #[arg(long, default_value = "std", value_parser = ["std", "rms"])]
+    snr_reference: String,
     /// Settling time of each run, s (not written).
     #[arg(long, default_value_t = 3.0)]
     settle: f64,
@@ -74,7 +80,12 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         format,
         jobs,
         shard,
-        snr_db: args.snr_db,
+        noise: args.snr_db.map(|snr| {
+            railforce::sensors::NoiseModel::new(
+                snr,
+                railforce::sensors::SnrReference::parse(&args.snr_reference).unwrap_or_default(),
+            )
+        }),
         settle: args.settle,
     };
     let total = dataset::runs(&plan)

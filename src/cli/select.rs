@@ -3,6 +3,7 @@
 use anyhow::Result;
 use clap::Args;
 use railforce::features::{self, DataSet, LabelAt, SelectOptions, Split};
+use railforce::sensors::Candidates;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -28,6 +29,15 @@ pub struct SelectArgs {
     /// Label at the centre step of the window (non-causal) instead of the last.
     #[arg(long)]
     centre_label: bool,
+    /// The signals to choose from: `paper21` (the paper's 21) or `onboard` (every on-board
+    /// measurable signal: body accelerations, angular rates, track-relative displacements
+    /// and angles, suspension deflections).
+    #[arg(long, default_value = "paper21", value_parser = ["paper21", "onboard"])]
+    candidates: String,
+    /// Rows the mutual-information estimator sees at most (evenly strided over the
+    /// training runs).
+    #[arg(long, default_value_t = 50_000)]
+    mi_samples: usize,
     /// Where to write the selection (channels and z-score statistics).
     #[arg(long, default_value = "selection.json")]
     out: PathBuf,
@@ -47,15 +57,21 @@ pub fn run(args: SelectArgs) -> Result<()> {
         } else {
             LabelAt::Last
         },
+        candidates: Candidates::parse(&args.candidates).unwrap_or(Candidates::Paper21),
+        mi_samples: args.mi_samples,
         ..SelectOptions::default()
     };
-    let sel = features::select(&ds, &Split::default(), &opts)?;
+    let split = Split::standard(&ds);
+    let sel = features::select(&ds, &split, &opts)?;
     println!(
-        "target {} ({}), {} runs, split 70/15/15 per run, window {}:",
+        "target {} ({}), {} runs, {} candidates, split {}, window {}, MI on at most {} training rows:",
         args.target,
         sel.target,
         ds.runs.len(),
-        sel.window
+        sel.table.len(),
+        split.describe(),
+        sel.window,
+        opts.mi_samples
     );
     println!(
         "  {:<22} {:>8} {:>13} {:>5}",
@@ -77,8 +93,9 @@ pub fn run(args: SelectArgs) -> Result<()> {
         w.write_all(b"\n")
     })?;
     println!(
-        "kept {} of 21 channels; wrote {} in {:.1} s",
+        "kept {} of {} channels; wrote {} in {:.1} s",
         sel.channels.len(),
+        sel.table.len(),
         args.out.display(),
         t0.elapsed().as_secs_f64()
     );

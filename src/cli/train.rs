@@ -9,7 +9,7 @@ use railforce::learn::evaluate::{EvalPart, evaluate};
 use railforce::learn::model::{Model, ModelKind};
 use railforce::learn::train::{Progress, TrainOptions, train};
 use railforce::learn::windows::DataSpec;
-use railforce::sim::output::PAPER_CHANNELS;
+use railforce::sensors::PAPER_CHANNELS;
 use std::path::{Path, PathBuf};
 
 /// Data and split options shared by `train` and the experiments.
@@ -29,8 +29,24 @@ pub struct DataArgs {
     /// `_noisy` inputs). Default: matched when the data set has `_noisy` columns, else clean.
     #[arg(long)]
     pub noise: Option<String>,
-    /// Hold out whole conditions for the test (comma separated) instead of 70/15/15 blocks;
-    /// validation then uses `--val-conditions`.
+    /// How runs are split: `seeds` (whole runs by irregularity seed: the default when the
+    /// data set has three or more seeds; the last tests, the one before validates, the rest
+    /// train), `blocks` (70/15/15 % contiguous blocks of every run: the default with fewer
+    /// seeds), `conditions` (with --test-conditions) or `shuffled` (stride-1 windows shuffled
+    /// 70/15/15: leaky, for comparison only).
+    #[arg(long, value_parser = ["seeds", "blocks", "conditions", "shuffled"])]
+    pub split: Option<String>,
+    /// Training seeds of the seed split (comma separated), instead of all but the last two.
+    #[arg(long, value_delimiter = ',')]
+    pub train_seeds: Vec<u64>,
+    /// Validation seeds of the seed split, instead of the one before last.
+    #[arg(long, value_delimiter = ',')]
+    pub val_seeds: Vec<u64>,
+    /// Test seeds of the seed split, instead of the last.
+    #[arg(long, value_delimiter = ',')]
+    pub test_seeds: Vec<u64>,
+    /// Hold out whole conditions for the test (comma separated); validation then uses
+    /// `--val-conditions`.
     #[arg(long, value_delimiter = ',')]
     pub test_conditions: Vec<String>,
     /// Conditions held out for validation (with --test-conditions).
@@ -117,8 +133,8 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
         }
     }
     let targets: Vec<String> = match args.target.as_str() {
-        "both" => vec!["w1l_force_y".into(), "w1l_force_z".into()],
-        t => vec![railforce::features::target_channel(t)],
+        "both" => ds.labels.to_vec(),
+        t => vec![ds.target_channel(t)],
     };
     let has_noisy = channels
         .iter()
@@ -131,14 +147,7 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
         Some("train-clean-test-noisy") => NoiseProtocol::TrainCleanTestNoisy,
         Some(o) => bail!("--noise {o}: expected clean, matched or train-clean-test-noisy"),
     };
-    let split = if args.test_conditions.is_empty() {
-        Split::default()
-    } else {
-        Split::Conditions {
-            val: args.val_conditions.clone(),
-            test: args.test_conditions.clone(),
-        }
-    };
+    let split = split(args, ds)?;
     Ok(DataSpec {
         channels,
         targets,
@@ -147,7 +156,70 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
         stride: args.stride,
         split,
         noise,
+        noise_model: if noise == NoiseProtocol::Clean {
+            None
+        } else {
+            ds.noise
+        },
     })
+}
+
+/// Resolves the split options against the data set's seeds.
+pub fn split(args: &DataArgs, ds: &DataSet) -> Result<Split> {
+    let seeds_given =
+        !(args.train_seeds.is_empty() && args.val_seeds.is_empty() && args.test_seeds.is_empty());
+    let kind = match args.split.as_deref() {
+        Some(k) => k,
+        None if !args.test_conditions.is_empty() => "conditions",
+        None if seeds_given => "seeds",
+        None => return Ok(Split::standard(ds)),
+    };
+    let split = match kind {
+        "blocks" => Split::default(),
+        "shuffled" => Split::Shuffled {
+            train: 0.70,
+            val: 0.15,
+            seed: 1,
+        },
+        "conditions" => {
+            if args.test_conditions.is_empty() {
+                bail!("--split conditions needs --test-conditions (and --val-conditions)");
+            }
+            Split::Conditions {
+                val: args.val_conditions.clone(),
+                test: args.test_conditions.clone(),
+            }
+        }
+        _ => {
+            let all = ds.seeds();
+            let (mut train, mut val, mut test) = match Split::standard(ds) {
+                Split::Seeds { train, val, test } => (train, val, test),
+                _ if seeds_given => (Vec::new(), Vec::new(), Vec::new()),
+                _ => bail!(
+                    "--split seeds needs three or more seeds in {} (it has {:?}); generate more with the plan's `seeds`, or give --train-seeds/--val-seeds/--test-seeds",
+                    ds.dir.display(),
+                    all
+                ),
+            };
+            for (given, part) in [
+                (&args.train_seeds, &mut train),
+                (&args.val_seeds, &mut val),
+                (&args.test_seeds, &mut test),
+            ] {
+                if !given.is_empty() {
+                    *part = given.clone();
+                }
+            }
+            for s in train.iter().chain(&val).chain(&test) {
+                if !all.contains(s) {
+                    bail!("seed {s} is not in {} (it has {:?})", ds.dir.display(), all);
+                }
+            }
+            Split::Seeds { train, val, test }
+        }
+    };
+    split.check()?;
+    Ok(split)
 }
 
 pub fn run(args: TrainArgs) -> Result<()> {
@@ -163,8 +235,8 @@ pub fn run(args: TrainArgs) -> Result<()> {
         windows_per_epoch: args.windows_per_epoch,
         classical_rows: args.classical_rows,
         resume: args.resume,
-        fresh_noise_snr_db: if args.fresh_noise {
-            Some(ds.snr_db().with_context(|| {
+        fresh_noise: if args.fresh_noise {
+            Some(ds.noise.with_context(|| {
                 format!(
                     "--fresh-noise: {}/manifest.json records no snr_db (generate with --snr-db)",
                     args.data.data.display()
@@ -176,7 +248,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         ..TrainOptions::default()
     };
     println!(
-        "training {} on {} ({} runs): {} channels × {} steps → {}; noise {:?}; split {:?}",
+        "training {} on {} ({} runs): {} channels × {} steps → {}; noise {:?}{}; split {}",
         kind.name(),
         args.data.data.display(),
         ds.runs.len(),
@@ -184,7 +256,10 @@ pub fn run(args: TrainArgs) -> Result<()> {
         spec.window,
         spec.targets.join(" + "),
         spec.noise,
-        spec.split
+        spec.noise_model
+            .map(|n| format!(" at {} dB (σ from the {})", n.snr_db, n.reference.name()))
+            .unwrap_or_default(),
+        spec.split.describe()
     );
     let model = train_with_bar(&ds, &spec, kind, &opts, &args.out)?;
     let t = &model.meta.training;

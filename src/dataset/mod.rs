@@ -9,13 +9,11 @@ pub mod parquet_file;
 
 use crate::error::{Error, Result};
 use crate::plan::{Condition, Plan};
-use crate::sim::output::{self, PAPER_CHANNELS, Recording};
+use crate::sensors::{ChannelKind, NoiseModel, PAPER_CHANNELS, label_channels, noisy_name};
+use crate::sim::output::{self, Recording};
 use crate::sim::{SimConfig, Simulation};
 use crate::track::{Track, TrackSpec};
 use crate::vehicle::Vehicle;
-use rand_chacha::ChaCha8Rng;
-use rand_chacha::rand_core::SeedableRng;
-use rand_distr::{Distribution, Normal};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -64,8 +62,9 @@ pub struct GenerateOptions {
     pub jobs: usize,
     /// This shard `(i, n)`, 1-based: runs with index `k` where `k % n == i − 1`.
     pub shard: Option<(usize, usize)>,
-    /// Add noised copies of the input channels at this signal-to-noise ratio, dB.
-    pub snr_db: Option<f64>,
+    /// Add noised copies (`<channel>_noisy`) of the paper's input channels with this noise
+    /// model (spec learning.md §1.4).
+    pub noise: Option<NoiseModel>,
     /// Settling time of each run, s.
     pub settle: f64,
 }
@@ -118,52 +117,6 @@ pub fn file_hash(path: &Path) -> Result<String> {
     Ok(fnv1a(&std::fs::read(path).map_err(|e| Error::io(path, e))?))
 }
 
-/// Noise standard deviation of a clean channel at `snr_db`: `σ = rms · 10^(−SNR/20)`, the
-/// rms of the clean channel (spec learning.md §1.4).
-pub fn noise_sigma(clean: &[f64], snr_db: f64) -> f64 {
-    let rms = (clean.iter().map(|x| x * x).sum::<f64>() / clean.len().max(1) as f64).sqrt();
-    rms * 10f64.powf(-snr_db / 20.0)
-}
-
-/// Noise per input channel (spec learning.md §1.4): white Gaussian, `σ_c = rms_c·10^(−SNR/20)`
-/// with `rms_c` the RMS of the clean channel over the run; seeded by the run's seed and the
-/// channel's position, so the same run gives the same noise.
-pub fn noise_column(clean: &[f64], snr_db: f64, seed: u64, channel: usize) -> Vec<f64> {
-    let sigma = noise_sigma(clean, snr_db);
-    let mut rng =
-        ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ channel as u64);
-    match Normal::new(0.0, sigma) {
-        Ok(n) if sigma > 0.0 => clean.iter().map(|x| x + n.sample(&mut rng)).collect(),
-        _ => clean.to_vec(),
-    }
-}
-
-/// What kind of channel a name is, for the manifest.
-fn channel_kind(name: &str) -> (&'static str, Option<String>) {
-    if name == "time_s" || name == "s_m" {
-        return ("axis", None);
-    }
-    if let Some(base) = name.strip_suffix("_noisy")
-        && PAPER_CHANNELS.contains(&base)
-    {
-        return ("input_noisy", None);
-    }
-    if PAPER_CHANNELS.contains(&name) {
-        return ("input", None);
-    }
-    if name == "w1l_force_y" || name == "w1l_force_z" {
-        return ("label", Some("1L".into()));
-    }
-    if let Some(rest) = name.strip_prefix('w')
-        && rest.len() > 3
-        && rest.as_bytes()[0].is_ascii_digit()
-        && rest.as_bytes()[2] == b'_'
-    {
-        return ("wheel", Some(rest[..2].to_ascii_uppercase()));
-    }
-    ("body", None)
-}
-
 /// Definition of a run for resuming: changes whenever anything that shapes its data changes.
 fn run_key(run: &RunSpec, opts: &GenerateOptions, track_hash: &str, vehicle_hash: &str) -> String {
     fnv1a(
@@ -175,7 +128,7 @@ fn run_key(run: &RunSpec, opts: &GenerateOptions, track_hash: &str, vehicle_hash
             run.condition.speed_kmh,
             run.condition.duration,
             run.seed,
-            opts.snr_db,
+            opts.noise,
             opts.format.ext(),
             opts.settle,
             env!("CARGO_PKG_VERSION")
@@ -236,13 +189,17 @@ pub fn generate(
             "--shard must be i/N with 1 ≤ i ≤ N, got {i}/{n}"
         )));
     }
-    if let Some(snr) = opts.snr_db
-        && !snr.is_finite()
+    if let Some(n) = opts.noise
+        && !n.snr_db.is_finite()
     {
-        return Err(Error::Domain(format!("--snr-db must be finite, got {snr}")));
+        return Err(Error::Domain(format!(
+            "--snr-db must be finite, got {}",
+            n.snr_db
+        )));
     }
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
     let vehicle = Vehicle::load(&plan.vehicle)?;
+    let labels = label_channels(&vehicle.label_wheel_name());
     let vehicle_hash = file_hash(&plan.vehicle)?;
     // Check every track before any run (a bad file should fail now, not after an hour).
     let mine: Vec<RunSpec> = runs(plan)
@@ -268,8 +225,9 @@ pub fn generate(
         "vehicle": {"file": plan.vehicle, "hash_fnv1a": vehicle_hash, "name": vehicle.name},
         "format": opts.format.ext(),
         "sampling_rate_hz": SimConfig::default().output_rate,
-        "snr_db": opts.snr_db,
-        "noise": "input channels only (suffix _noisy): white Gaussian, sigma = rms(clean) * 10^(-SNR/20), seeded per run and channel; clean channels always kept; labels never noised",
+        "snr_db": opts.noise.map(|n| n.snr_db),
+        "snr_reference": opts.noise.map(|n| n.reference.name()),
+        "noise": opts.noise.map(|n| format!("{}; the paper's input channels only (suffix _noisy), clean channels always kept", n.describe())),
         "shard": opts.shard.map(|(i, n)| format!("{i}/{n}")),
         "conventions": {
             "frame": "track frame: x along the running direction, y to the left, z up",
@@ -277,7 +235,7 @@ pub fn generate(
             "wheels": "1L..4R numbered from the front, left/right facing the running direction",
             "accelerations": vehicle.accelerometers.describe(),
             "accelerometers": vehicle.accelerometers.name(),
-            "labels": {"FL": "w1l_force_y", "FQ": "w1l_force_z"},
+            "labels": {"FL": labels[0], "FQ": labels[1], "wheel": vehicle.label_wheel_name()},
         },
         "channels": Value::Null,
         "runs": [],
@@ -317,8 +275,8 @@ pub fn generate(
         let mut rec = output::record(&mut sim, |_| {}).map_err(|e| {
             Error::Domain(format!("{} (seed {}): {e}", run.condition.name, run.seed))
         })?;
-        if let Some(snr) = opts.snr_db {
-            add_noise(&mut rec, snr, run.seed);
+        if let Some(noise) = opts.noise {
+            add_noise(&mut rec, &noise, run.seed);
         }
         write_run(&path, &rec, opts.format)?;
         let bytes_hash = file_hash(&path)?;
@@ -342,8 +300,10 @@ pub fn generate(
                 .iter()
                 .zip(&rec.units)
                 .map(|(n, u)| {
-                    let (kind, wheel) = channel_kind(n);
-                    json!({"name": n, "unit": u, "kind": kind, "wheel": wheel})
+                    let kind = ChannelKind::of(n, &labels);
+                    let wheel = (kind == ChannelKind::Label || kind == ChannelKind::Wheel)
+                        .then(|| n[1..3].to_ascii_uppercase());
+                    json!({"name": n, "unit": u, "kind": kind.name(), "wheel": wheel})
                 })
                 .collect();
         }
@@ -391,7 +351,7 @@ fn sort_runs(m: &mut Value) {
 }
 
 /// Appends `<name>_noisy` copies of the paper's input channels.
-fn add_noise(rec: &mut Recording, snr_db: f64, seed: u64) {
+fn add_noise(rec: &mut Recording, noise: &NoiseModel, seed: u64) {
     let inputs: Vec<(usize, String)> = rec
         .names
         .iter()
@@ -399,9 +359,9 @@ fn add_noise(rec: &mut Recording, snr_db: f64, seed: u64) {
         .filter(|(_, n)| PAPER_CHANNELS.contains(&n.as_str()))
         .map(|(i, n)| (i, n.clone()))
         .collect();
-    for (c, (i, name)) in inputs.into_iter().enumerate() {
-        let noisy = noise_column(&rec.column(i), snr_db, seed, c);
-        rec.names.push(format!("{name}_noisy"));
+    for (i, name) in inputs {
+        let noisy = noise.apply(&rec.column(i), seed, &name);
+        rec.names.push(noisy_name(&name));
         rec.units.push(rec.units[i]);
         for (row, v) in rec.rows.iter_mut().zip(noisy) {
             row.push(v);
@@ -457,7 +417,7 @@ pub fn merge(out: &Path) -> Result<Value> {
         match merged.as_mut() {
             None => merged = Some(m),
             Some(all) => {
-                for key in ["vehicle", "format", "snr_db", "plan"] {
+                for key in ["vehicle", "format", "snr_db", "snr_reference", "plan"] {
                     if all[key] != m[key] {
                         return Err(Error::Domain(format!(
                             "{} disagrees with the other shards on '{key}'",

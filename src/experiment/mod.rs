@@ -1,23 +1,30 @@
-//! The paper's three experiments on railforce data (spec learning.md §4): model comparison,
-//! generalisation over conditions (with leave-one-condition-out, which the paper never ran),
-//! and robustness to noise under both noise protocols. Each writes Markdown and CSV tables,
-//! SVG figures and its part of `index.html`, with seeds, data identity, versions and timings.
+//! The paper's experiments on railforce data (spec learning.md §4), and two of ours: model
+//! comparison, generalisation over conditions (with leave-one-condition-out, which the paper
+//! never ran), robustness to noise under both noise protocols, the protocols side by side, and
+//! on-board sensor selection. Defaults: the plan's seeds split by seed (independent test runs),
+//! 6 dB with σ from each channel's standard deviation, window 20 with the centre label, fresh
+//! training noise. Each writes Markdown and CSV tables, SVG figures and its part of
+//! `index.html`, with seeds, data identity, protocol, noise definition, label position,
+//! versions and timings.
 
+mod comparison;
+mod generalization;
 pub mod paper;
+mod protocols;
+mod robustness;
+mod sensors;
 
-use crate::dataset::{Format, GenerateOptions, generate, noise_column};
+use crate::dataset::{Format, GenerateOptions, generate};
 use crate::error::{Error, Result};
 use crate::features::{DataSet, LabelAt, NoiseProtocol, Split};
-use crate::learn::evaluate::{EvalPart, PredictionRow, evaluate};
+use crate::learn::evaluate::PredictionRow;
 use crate::learn::metrics::{Metrics, metrics};
 use crate::learn::model::{Model, ModelKind};
 use crate::learn::train::{EpochLog, Progress, TrainOptions, train};
 use crate::learn::windows::{DataSpec, prepare};
 use crate::plan::Plan;
-use crate::report::svg::{Chart, Series};
-use crate::report::table::Table;
 use crate::report::{Section, write_index};
-use crate::sim::output::PAPER_CHANNELS;
+use crate::sensors::{Candidates, NoiseModel, PAPER_CHANNELS, SnrReference};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -25,14 +32,43 @@ use std::time::Instant;
 /// Which experiment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Which {
-    /// Eight models on one condition.
+    /// Eight models on one condition, one model per target.
     Comparison,
     /// One CNN-BiLSTM over all conditions, and leave-one-condition-out.
     Generalization,
     /// SNR sweep.
     Robustness,
-    /// All three.
+    /// The CNN-BiLSTM under the seed, block, condition and shuffled splits.
+    Protocols,
+    /// Filter–Wrapper over the on-board candidates against the paper's 21.
+    Sensors,
+    /// The paper's three (comparison, generalisation, robustness): the demo.
+    Paper,
+    /// All five.
     All,
+}
+
+impl Which {
+    /// The experiments this choice runs, in order.
+    pub fn parts(self) -> Vec<Which> {
+        use Which::*;
+        match self {
+            All => vec![Comparison, Generalization, Robustness, Protocols, Sensors],
+            Paper => vec![Comparison, Generalization, Robustness],
+            w => vec![w],
+        }
+    }
+
+    fn folder(self) -> &'static str {
+        match self {
+            Which::Comparison => "comparison",
+            Which::Generalization => "generalization",
+            Which::Robustness => "robustness",
+            Which::Protocols => "protocols",
+            Which::Sensors => "sensors",
+            _ => "all",
+        }
+    }
 }
 
 /// Settings of a run of experiments.
@@ -42,8 +78,10 @@ pub struct ExperimentOptions {
     pub plan: PathBuf,
     /// Output folder (data/, one folder per experiment, index.html).
     pub out: PathBuf,
-    /// SNR of the comparison and generalisation, dB.
+    /// SNR of the comparison, generalisation and protocols, dB.
     pub snr_db: f64,
+    /// What the SNR is measured against (each channel's standard deviation by default).
+    pub snr_reference: SnrReference,
     /// Condition of the comparison and robustness experiments.
     pub condition: String,
     /// Models of the comparison.
@@ -52,28 +90,36 @@ pub struct ExperimentOptions {
     pub robustness_models: Vec<ModelKind>,
     /// SNRs of the sweep, dB.
     pub snrs: Vec<f64>,
+    /// SNRs of the sensors experiment, dB.
+    pub sensor_snrs: Vec<f64>,
     /// Conditions held out one at a time (empty: a curve, a tangent and a gradient case).
     pub loco: Vec<String>,
-    /// Training settings (networks and classical).
+    /// Training settings (networks and classical) of the all-condition models.
     pub train: TrainOptions,
+    /// Training windows per epoch of the one-condition models (comparison, robustness).
+    pub condition_windows_per_epoch: usize,
     /// Simulations in parallel.
     pub jobs: usize,
-    /// Label position (the last step: causal, the default; the centre: as the paper reads).
+    /// Label position (the centre: as the paper reads, the default; the last: causal).
     pub label_at: LabelAt,
     /// Window length, steps (the paper's 20 by default).
     pub window: usize,
     /// Networks trained at an SNR (matched protocol) draw new training-input noise every
     /// epoch instead of learning one fixed realisation (validation and test keep theirs).
     pub fresh_noise: bool,
+    /// The split (default: by seed when the plan has at least three seeds, see
+    /// [`Split::standard`]).
+    pub split: Option<Split>,
 }
 
 impl ExperimentOptions {
-    /// The full protocol of the paper's experiments.
+    /// The full protocol of the experiments (spec learning.md §4).
     pub fn full(plan: PathBuf, out: PathBuf) -> Self {
         ExperimentOptions {
             plan,
             out,
             snr_db: 6.0,
+            snr_reference: SnrReference::Std,
             condition: "curve_r400_v60".into(),
             models: ModelKind::ALL.to_vec(),
             robustness_models: vec![
@@ -83,122 +129,108 @@ impl ExperimentOptions {
                 ModelKind::CnnBiLstm,
             ],
             snrs: vec![1000.0, 100.0, 60.0, 40.0, 30.0, 20.0, 10.0, 5.0, 3.0, 1.0],
+            sensor_snrs: vec![6.0, 1.0],
             loco: Vec::new(),
             train: TrainOptions {
                 epochs: 100,
                 patience: 10,
                 windows_per_epoch: Some(50_000),
+                val_windows: Some(40_000),
                 ..TrainOptions::default()
             },
+            condition_windows_per_epoch: 12_000,
             jobs: 2,
-            label_at: LabelAt::Last,
+            label_at: LabelAt::Centre,
             window: 20,
             fresh_noise: true,
+            split: None,
+        }
+    }
+
+    fn noise(&self, snr: f64) -> NoiseModel {
+        NoiseModel::new(snr, self.snr_reference)
+    }
+
+    fn label_words(&self) -> &'static str {
+        match self.label_at {
+            LabelAt::Last => "last step (causal)",
+            LabelAt::Centre => "centre step (the paper's, non-causal)",
         }
     }
 }
 
-/// The columns the experiments keep (inputs, labels, time): the rest of a run is dropped.
-fn slim(ds: &DataSet) -> Result<DataSet> {
-    let mut keep: Vec<&str> = vec!["time_s", "w1l_force_y", "w1l_force_z"];
-    keep.extend(PAPER_CHANNELS.iter().copied());
-    let idx = keep
-        .iter()
-        .map(|n| ds.channel(n))
-        .collect::<Result<Vec<_>>>()?;
-    Ok(DataSet {
-        dir: ds.dir.clone(),
-        names: keep.iter().map(|s| s.to_string()).collect(),
-        runs: ds
-            .runs
-            .iter()
-            .map(|r| crate::features::Run {
-                condition: r.condition.clone(),
-                seed: r.seed,
-                columns: idx.iter().map(|&i| r.columns[i].clone()).collect(),
-            })
-            .collect(),
-    })
-}
-
-/// A copy with `_noisy` inputs at `snr` dB (replacing any), seeded by run seed and channel.
-pub fn with_noise(ds: &DataSet, snr: f64) -> DataSet {
-    let mut out = ds.clone();
-    let base: Vec<usize> = PAPER_CHANNELS
-        .iter()
-        .filter_map(|c| ds.channel(c).ok())
-        .collect();
-    let noisy_names: Vec<String> = PAPER_CHANNELS
-        .iter()
-        .map(|c| format!("{c}_noisy"))
-        .collect();
-    let keep: Vec<usize> = (0..ds.names.len())
-        .filter(|&i| !ds.names[i].ends_with("_noisy"))
-        .collect();
-    out.names = keep
-        .iter()
-        .map(|&i| ds.names[i].clone())
-        .chain(noisy_names)
-        .collect();
-    for (r, run) in out.runs.iter_mut().enumerate() {
-        let src = &ds.runs[r];
-        let mut cols: Vec<Vec<f64>> = keep.iter().map(|&i| src.columns[i].clone()).collect();
-        for (k, &c) in base.iter().enumerate() {
-            cols.push(noise_column(&src.columns[c], snr, src.seed, k));
-        }
-        run.columns = cols;
-    }
-    out
-}
-
-fn subset(ds: &DataSet, conditions: &[String]) -> DataSet {
-    DataSet {
-        dir: ds.dir.clone(),
-        names: ds.names.clone(),
-        runs: ds
-            .runs
-            .iter()
-            .filter(|r| conditions.contains(&r.condition))
-            .cloned()
-            .collect(),
-    }
-}
-
-fn spec(opts: &ExperimentOptions, noise: NoiseProtocol, split: Split) -> DataSpec {
-    DataSpec {
-        channels: PAPER_CHANNELS.iter().map(|c| c.to_string()).collect(),
-        targets: vec!["w1l_force_y".into(), "w1l_force_z".into()],
-        window: opts.window,
-        label_at: opts.label_at,
-        stride: 1,
-        split,
-        noise,
-    }
-}
-
+/// Shared state of a run of experiments.
 struct Ctx<'a> {
     opts: &'a ExperimentOptions,
     log: &'a mut dyn FnMut(String),
+    /// All conditions, clean, with the paper's inputs, the labels and time.
+    ds: DataSet,
+    /// The split every experiment uses unless it studies splits.
+    split: Split,
+    /// Plan order of the conditions.
+    conditions: Vec<String>,
+    /// Pooled test metrics of the all-condition CNN-BiLSTM on the paper's 21 at the
+    /// experiments' SNR under the default split, once trained (generalisation): the same model
+    /// the protocols and sensors experiments would train again, so they reuse it.
+    pooled: Option<Vec<Metrics>>,
 }
 
 impl Ctx<'_> {
-    /// Trains `kind`; with the matched protocol at `snr` dB, networks draw fresh training
-    /// noise every epoch when the options say so ([`ExperimentOptions::fresh_noise`]).
+    /// Data spec of a model over `channels` predicting `targets`.
+    fn spec(
+        &self,
+        channels: &[String],
+        targets: &[String],
+        noise: NoiseProtocol,
+        split: Split,
+        snr: Option<f64>,
+    ) -> DataSpec {
+        DataSpec {
+            channels: channels.to_vec(),
+            targets: targets.to_vec(),
+            window: self.opts.window,
+            label_at: self.opts.label_at,
+            stride: 1,
+            split,
+            noise,
+            noise_model: snr.map(|s| self.opts.noise(s)),
+        }
+    }
+
+    /// The paper's 21 inputs.
+    fn paper21() -> Vec<String> {
+        PAPER_CHANNELS.iter().map(|c| c.to_string()).collect()
+    }
+
+    /// Both labels.
+    fn labels(&self) -> Vec<String> {
+        self.ds.labels.to_vec()
+    }
+
+    /// A copy of `ds` with the inputs of `channels` noised at `snr`.
+    fn noisy(&self, ds: &DataSet, snr: f64, channels: &[String]) -> Result<DataSet> {
+        ds.with_noise(self.opts.noise(snr), channels)
+    }
+
+    /// Trains `kind`; with the matched protocol, networks draw fresh training noise every
+    /// epoch when the options say so ([`ExperimentOptions::fresh_noise`]).
     fn fit(
         &mut self,
         ds: &DataSet,
         spec: &DataSpec,
         kind: ModelKind,
         dir: &Path,
-        snr: Option<f64>,
+        windows_per_epoch: Option<usize>,
     ) -> Result<(Model, f64)> {
         let t0 = Instant::now();
         let name = format!("{} → {}", kind.name(), dir.display());
         (self.log)(format!("training {name}"));
         let log = &mut self.log;
         let opts = TrainOptions {
-            fresh_noise_snr_db: snr
+            fresh_noise: spec
+                .noise_model
                 .filter(|_| self.opts.fresh_noise && spec.noise == NoiseProtocol::Matched),
+            windows_per_epoch: windows_per_epoch.or(self.opts.train.windows_per_epoch),
             ..self.opts.train.clone()
         };
         let model = train(ds, spec, kind, &opts, dir, &mut |p| {
@@ -215,6 +247,26 @@ impl Ctx<'_> {
         (self.log)(format!("  done in {secs:.1} s"));
         Ok((model, secs))
     }
+
+    /// The protocol paragraph every section carries.
+    fn protocol(&self, split: &Split, snr: Option<f64>) -> String {
+        format!(
+            "Protocol: {}; z-scores from the training part only; windows of {} steps, label at the {}; noise: {}. MSE and R² on standardised targets, Var(y_test) beside them.",
+            split.describe(),
+            self.opts.window,
+            self.opts.label_words(),
+            snr.map(|s| self.opts.noise(s).describe())
+                .unwrap_or_else(|| "none (clean inputs)".into())
+        )
+    }
+}
+
+/// The columns the experiments keep (time, labels, the candidates): the rest is dropped.
+fn slim(ds: &DataSet, candidates: Candidates) -> Result<DataSet> {
+    let mut keep: Vec<String> = vec!["time_s".into()];
+    keep.extend(ds.labels.iter().cloned());
+    keep.extend(candidates.among(&ds.names, &ds.labels));
+    ds.subset(None, Some(&keep))
 }
 
 /// Metrics on (at most 20 000 evenly strided) training windows.
@@ -232,284 +284,10 @@ fn train_metrics(model: &mut Model, ds: &DataSet) -> Result<Vec<Metrics>> {
     Ok(metrics(&y, &p, &stats.1))
 }
 
-fn f4(v: f64) -> String {
-    format!("{v:.4}")
-}
-
-fn read_log(dir: &Path) -> Vec<EpochLog> {
-    crate::io::read_text(&dir.join("train_log.jsonl"))
-        .map(|t| {
-            t.lines()
-                .filter_map(|l| serde_json::from_str(l).ok())
-                .collect()
-        })
-        .unwrap_or_default()
-}
-
-/// Runs the experiments; returns the path of `index.html`.
-pub fn run(which: Which, opts: &ExperimentOptions, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
-    let t0 = Instant::now();
-    let plan = Plan::load(&opts.plan)?;
-    let data_dir = opts.out.join("data");
-    log(format!(
-        "simulating {} condition(s) of {} into {} (resumable) …",
-        plan.conditions.len(),
-        plan.name,
-        data_dir.display()
-    ));
-    let gopts = GenerateOptions {
-        out: data_dir.clone(),
-        format: Format::Npz,
-        jobs: opts.jobs.max(1),
-        shard: None,
-        snr_db: None,
-        settle: 3.0,
-    };
-    generate(&plan, &gopts, &|_| {})?;
-    let ds = slim(&DataSet::load(&data_dir)?)?;
-    let manifest_hash = crate::dataset::file_hash(&data_dir.join("manifest.json"))?;
-    let mut ctx = Ctx { opts, log };
-    let mut sections: Vec<(String, Section)> = Vec::new();
-    let mut timings = serde_json::Map::new();
-    let conditions: Vec<String> = plan.conditions.iter().map(|c| c.name.clone()).collect();
-    if matches!(which, Which::Comparison | Which::Robustness | Which::All)
-        && !conditions.contains(&opts.condition)
-    {
-        return Err(Error::Domain(format!(
-            "condition {} is not in the plan {}",
-            opts.condition,
-            opts.plan.display()
-        )));
-    }
-    for (part, folder) in [
-        (Which::Comparison, "comparison"),
-        (Which::Generalization, "generalization"),
-        (Which::Robustness, "robustness"),
-    ] {
-        if which != part && which != Which::All {
-            continue;
-        }
-        let ts = Instant::now();
-        let sec = match part {
-            Which::Comparison => comparison(&mut ctx, &ds)?,
-            Which::Generalization => generalization(&mut ctx, &ds, &conditions)?,
-            _ => robustness(&mut ctx, &ds)?,
-        };
-        sec.write_files(&opts.out.join(folder))?;
-        sections.push((folder.into(), sec));
-        timings.insert(format!("{folder}_s"), json!(ts.elapsed().as_secs_f64()));
-    }
-    let wall = t0.elapsed().as_secs_f64();
-    let meta = json!({
-        "plan": opts.plan.display().to_string(),
-        "plan_name": plan.name,
-        "data_manifest_fnv1a": manifest_hash,
-        "runs": ds.runs.len(),
-        "snr_db": opts.snr_db,
-        "condition": opts.condition,
-        "training": opts.train,
-        "label_at": format!("{:?}", opts.label_at),
-        "window": opts.window,
-        "fresh_noise_every_epoch": opts.fresh_noise,
-        "railforce_version": env!("CARGO_PKG_VERSION"),
-        "wall_seconds": wall,
-        "timings": timings,
-        "protocol": format!("70/15/15 % contiguous blocks per run (or whole conditions held out), z-scores from training blocks, window {} × 21 channels, FL and FQ as two outputs of one model", opts.window),
-    });
-    let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");
-    crate::io::write_atomic(&opts.out.join("meta.json"), |w| w.write_all(mj.as_bytes()))?;
-    let intro = vec![
-        format!(
-            "railforce {} — plan {} ({} runs, data manifest {}), seed {}, wall time {:.0} s.",
-            env!("CARGO_PKG_VERSION"),
-            plan.name,
-            ds.runs.len(),
-            manifest_hash,
-            opts.train.seed,
-            wall
-        ),
-        format!(
-            "Protocol: each run cut into contiguous 70/15/15 % train/validation/test blocks before windowing (no window crosses a block), z-scores from the training blocks only, windows of {} steps × 21 channels, label at the {} step, FL (w1l_force_y) and FQ (w1l_force_z) as the two outputs of one model. MSE and R² on standardised targets; Var(y_test) shown beside them. Paper numbers come from another simulator and unknown splits: a bar, not a target to match digit for digit.",
-            opts.window,
-            if opts.label_at == LabelAt::Last {
-                "last (causal)"
-            } else {
-                "centre (non-causal)"
-            }
-        ),
-        format!(
-            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch{}; classical models on at most {} windows.",
-            opts.train.lr,
-            opts.train.batch,
-            opts.train.epochs,
-            opts.train.patience,
-            opts.train
-                .windows_per_epoch
-                .map(|w| w.to_string())
-                .unwrap_or("all".into()),
-            if opts.fresh_noise {
-                "; networks trained at an SNR draw new input noise every epoch (validation and test keep one fixed, seeded realisation)"
-            } else {
-                "; networks trained on one fixed noise realisation"
-            },
-            opts.train.classical_rows
-        ),
-    ];
-    write_index(
-        &opts.out,
-        "railforce: wheel–rail force identification experiments",
-        &intro,
-        &sections,
-    )?;
-    Ok(opts.out.join("index.html"))
-}
-
-fn comparison(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
-    let opts = ctx.opts;
-    let dsc = with_noise(
-        &subset(ds, std::slice::from_ref(&opts.condition)),
-        opts.snr_db,
-    );
-    let sp = spec(opts, NoiseProtocol::Matched, Split::default());
-    let dir = opts.out.join("comparison");
-    let mut tables: [Table; 2] = std::array::from_fn(|_| {
-        Table::new(&[
-            "model",
-            "train MSE",
-            "train R²",
-            "test MSE",
-            "test R²",
-            "Var(y_test)",
-            "test RMSE kN",
-            "fit s",
-            "paper train MSE / R²",
-            "paper test MSE / R²",
-        ])
-    });
-    let mut curves = Vec::new();
-    let mut traces: Option<Vec<PredictionRow>> = None;
-    for &kind in &opts.models {
-        let mdir = dir.join("models").join(kind.name());
-        let (mut model, secs) = ctx.fit(&dsc, &sp, kind, &mdir, Some(opts.snr_db))?;
-        let tr = train_metrics(&mut model, &dsc)?;
-        let te = evaluate(&mut model, &dsc, EvalPart::Test)?;
-        let paper = paper::COMPARISON
-            .iter()
-            .find(|(n, _)| *n == kind.name())
-            .map(|(_, v)| *v);
-        for k in 0..2 {
-            let p = paper.map(|v| {
-                (
-                    format!("{} / {}", v[4 * k], v[4 * k + 1]),
-                    format!("{} / {}", v[4 * k + 2], v[4 * k + 3]),
-                )
-            });
-            let (pa, pb) = p.unwrap_or_default();
-            let m = &te.metrics[k];
-            tables[k].push(vec![
-                kind.name().into(),
-                f4(tr[k].mse),
-                f4(tr[k].r2),
-                f4(m.mse),
-                f4(m.r2),
-                f4(m.var_y),
-                format!("{:.2}", m.rmse_kn),
-                format!("{secs:.1}"),
-                pa,
-                pb,
-            ]);
-        }
-        if kind.architecture().is_some() {
-            let l = read_log(&mdir);
-            curves.push(Series {
-                label: kind.name().into(),
-                points: l.iter().map(|e| (e.epoch as f64, e.val_loss)).collect(),
-            });
-        }
-        if kind == ModelKind::CnnBiLstm
-            || (traces.is_none() && kind == *opts.models.last().expect("models"))
-        {
-            traces = Some(te.rows.clone());
-        }
-    }
-    let [fl, fq] = tables;
-    let mut sec = Section {
-        title: format!(
-            "1. Model comparison: {} at {} dB (paper Tables 2–3)",
-            opts.condition, opts.snr_db
-        ),
-        text: vec![format!(
-            "{} models on {} with every input noised at {} dB, trained and tested on the noisy inputs (matched protocol). Train metrics on up to 20 000 training windows; test metrics on every test window.",
-            opts.models.len(),
-            opts.condition,
-            opts.snr_db
-        )],
-        tables: vec![
-            (
-                "Lateral force FL (w1l_force_y)".into(),
-                fl,
-                "comparison_fl".into(),
-            ),
-            (
-                "Vertical force FQ (w1l_force_z)".into(),
-                fq,
-                "comparison_fq".into(),
-            ),
-        ],
-        figures: Vec::new(),
-    };
-    if !curves.is_empty() {
-        sec.figures.push((
-            "Training curves: validation MSE per epoch".into(),
-            Chart {
-                title: "Validation loss".into(),
-                x_label: "epoch".into(),
-                y_label: "MSE (standardised)".into(),
-                log_x: false,
-                y_range: None,
-                series: curves,
-            },
-            "training_curves.svg".into(),
-        ));
-    }
-    if let Some(rows) = traces {
-        let first = rows.first().map(|r| (r.0.clone(), r.1));
-        let pts: Vec<&PredictionRow> = rows
-            .iter()
-            .filter(|r| Some((r.0.clone(), r.1)) == first)
-            .take(800)
-            .collect();
-        for (k, name) in [(0, "FL"), (1, "FQ")] {
-            let series = vec![
-                Series {
-                    label: "true".into(),
-                    points: pts.iter().map(|r| (r.2, r.3[k].0 / 1000.0)).collect(),
-                },
-                Series {
-                    label: "identified".into(),
-                    points: pts.iter().map(|r| (r.2, r.3[k].1 / 1000.0)).collect(),
-                },
-            ];
-            sec.figures.push((
-                format!("{name}: identified against true force on the test block (first 4 s)"),
-                Chart {
-                    title: format!("{name}, test block"),
-                    x_label: "time (s)".into(),
-                    y_label: "force (kN)".into(),
-                    log_x: false,
-                    y_range: None,
-                    series,
-                },
-                format!("trace_{}.svg", name.to_lowercase()),
-            ));
-        }
-    }
-    Ok(sec)
-}
-
+/// Per target, (MSE, R², Var(y)) in standardised units over the rows of one condition.
 fn per_condition(rows: &[PredictionRow], model: &Model, condition: &str) -> Vec<(f64, f64, f64)> {
     let ts = &model.meta.target_stats;
-    (0..2)
+    (0..ts.mean.len())
         .map(|k| {
             let pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -530,249 +308,167 @@ fn per_condition(rows: &[PredictionRow], model: &Model, condition: &str) -> Vec<
         .collect()
 }
 
-fn generalization(ctx: &mut Ctx, ds: &DataSet, conditions: &[String]) -> Result<Section> {
-    let opts = ctx.opts;
-    let dsn = with_noise(ds, opts.snr_db);
-    let dir = opts.out.join("generalization");
-    let (mut model, secs) = ctx.fit(
-        &dsn,
-        &spec(opts, NoiseProtocol::Matched, Split::default()),
-        ModelKind::CnnBiLstm,
-        &dir.join("models/all_conditions"),
-        Some(opts.snr_db),
-    )?;
-    let ev = evaluate(&mut model, &dsn, EvalPart::Test)?;
-    let mut t = Table::new(&[
-        "condition",
-        "FL MSE",
-        "FL R²",
-        "FQ MSE",
-        "FQ R²",
-        "Var(FQ_test)",
-        "paper FQ MSE / R²",
-    ]);
-    let (mut fl_pts, mut fq_pts, mut paper_pts) = (Vec::new(), Vec::new(), Vec::new());
-    let mut in_dist = std::collections::HashMap::new();
-    for (i, c) in conditions.iter().enumerate() {
-        let m = per_condition(&ev.rows, &model, c);
-        let p = paper::generalization(c);
-        t.push(vec![
-            c.clone(),
-            f4(m[0].0),
-            f4(m[0].1),
-            f4(m[1].0),
-            f4(m[1].1),
-            f4(m[1].2),
-            p.map(|(a, b)| format!("{a} / {b}")).unwrap_or("—".into()),
-        ]);
-        fl_pts.push((i as f64 + 1.0, m[0].1));
-        fq_pts.push((i as f64 + 1.0, m[1].1));
-        if let Some((_, r2)) = p {
-            paper_pts.push((i as f64 + 1.0, r2));
-        }
-        in_dist.insert(c.clone(), (m[0].1, m[1].1));
-    }
-    let all = &ev.metrics;
-    t.push(vec![
-        "all (pooled)".into(),
-        f4(all[0].mse),
-        f4(all[0].r2),
-        f4(all[1].mse),
-        f4(all[1].r2),
-        f4(all[1].var_y),
-        "—".into(),
-    ]);
-    // Leave one condition out.
-    let loco: Vec<String> = if opts.loco.is_empty() {
-        ["curve_r400_v60", "tangent_v80", "grade20_L50_v60"]
-            .iter()
-            .map(|s| s.to_string())
-            .filter(|c| conditions.contains(c))
-            .collect()
-    } else {
-        opts.loco.clone()
-    };
-    let mut lt = Table::new(&[
-        "held-out condition",
-        "validation condition",
-        "FL R² unseen",
-        "FQ R² unseen",
-        "FL R² seen",
-        "FQ R² seen",
-    ]);
-    for c in &loco {
-        let pos = conditions.iter().position(|x| x == c).ok_or_else(|| {
-            Error::Domain(format!("leave-one-out condition {c} is not in the plan"))
-        })?;
-        let val = conditions[(pos + 1) % conditions.len()].clone();
-        if conditions.len() < 3 {
-            return Err(Error::Domain(
-                "leave-one-condition-out needs at least three conditions".into(),
-            ));
-        }
-        let sp = spec(
-            opts,
-            NoiseProtocol::Matched,
-            Split::Conditions {
-                val: vec![val.clone()],
-                test: vec![c.clone()],
-            },
-        );
-        let (mut m, _) = ctx.fit(
-            &dsn,
-            &sp,
-            ModelKind::CnnBiLstm,
-            &dir.join(format!("models/without_{c}")),
-            Some(opts.snr_db),
-        )?;
-        let e = evaluate(&mut m, &dsn, EvalPart::Test)?;
-        let seen = in_dist.get(c).copied().unwrap_or((f64::NAN, f64::NAN));
-        lt.push(vec![
-            c.clone(),
-            val,
-            f4(e.metrics[0].r2),
-            f4(e.metrics[1].r2),
-            f4(seen.0),
-            f4(seen.1),
-        ]);
-    }
-    let series = vec![
-        Series {
-            label: "FL (ours)".into(),
-            points: fl_pts,
-        },
-        Series {
-            label: "FQ (ours)".into(),
-            points: fq_pts,
-        },
-        Series {
-            label: "FQ (paper)".into(),
-            points: paper_pts,
-        },
-    ];
-    Ok(Section {
-        title: "2. Generalisation over conditions (paper Tables 4–5)".into(),
-        text: vec![
-            format!("One CNN-BiLSTM trained on the training blocks of all {} conditions at {} dB ({secs:.0} s), scored on each condition's test block.", conditions.len(), opts.snr_db),
-            "Leave-one-condition-out (not in the paper): the model is trained without the held-out condition (and without the validation condition used for early stopping) and tested on all of the held-out run — transfer to an unseen condition.".into(),
-        ],
-        tables: vec![
-            ("Per-condition test metrics".into(), t, "per_condition".into()),
-            ("Leave one condition out".into(), lt, "leave_one_out".into()),
-        ],
-        figures: vec![(
-            "Test R² per condition (numbered in plan order)".into(),
-            Chart { title: "R² per condition".into(), x_label: "condition (plan order)".into(), y_label: "test R²".into(), log_x: false, y_range: None, series },
-            "r2_per_condition.svg".into(),
-        )],
-    })
+fn f4(v: f64) -> String {
+    format!("{v:.4}")
 }
 
-fn robustness(ctx: &mut Ctx, ds: &DataSet) -> Result<Section> {
-    let opts = ctx.opts;
-    let base = subset(ds, std::slice::from_ref(&opts.condition));
-    let dir = opts.out.join("robustness");
-    let mut t = Table::new(&[
-        "protocol",
-        "SNR dB",
-        "model",
-        "FL MSE",
-        "FL R²",
-        "FQ MSE",
-        "FQ R²",
-        "paper R² at 1 dB",
-    ]);
-    let mut charts = Vec::new();
-    for (proto, label) in [
-        (
-            NoiseProtocol::TrainCleanTestNoisy,
-            "train clean, test noisy",
-        ),
-        (NoiseProtocol::Matched, "train and test at the SNR"),
-    ] {
-        let mut series = Vec::new();
-        for &kind in &opts.robustness_models {
-            let mut pts = Vec::new();
-            let clean_model = if proto == NoiseProtocol::TrainCleanTestNoisy {
-                let (mut m, _) = ctx.fit(
-                    &base,
-                    &spec(opts, NoiseProtocol::Clean, Split::default()),
-                    kind,
-                    &dir.join(format!("models/clean_{}", kind.name())),
-                    None,
-                )?;
-                m.meta.data.noise = NoiseProtocol::TrainCleanTestNoisy;
-                Some(m)
-            } else {
-                None
-            };
-            let mut clean_model = clean_model;
-            for &snr in &opts.snrs {
-                let dsn = with_noise(&base, snr);
-                let ev = match clean_model.as_mut() {
-                    Some(m) => evaluate(m, &dsn, EvalPart::Test)?,
-                    None => {
-                        let (mut m, _) = ctx.fit(
-                            &dsn,
-                            &spec(opts, NoiseProtocol::Matched, Split::default()),
-                            kind,
-                            &dir.join(format!("models/matched_{}_{snr}dB", kind.name())),
-                            Some(snr),
-                        )?;
-                        evaluate(&mut m, &dsn, EvalPart::Test)?
-                    }
-                };
-                let m = &ev.metrics;
-                let paper = if snr == 1.0 && proto == NoiseProtocol::Matched {
-                    paper::ROBUSTNESS_1DB
-                        .iter()
-                        .find(|(n, _)| *n == kind.name())
-                        .map(|(_, v)| v.to_string())
-                        .unwrap_or_default()
-                } else {
-                    String::new()
-                };
-                t.push(vec![
-                    label.into(),
-                    format!("{snr}"),
-                    kind.name().into(),
-                    f4(m[0].mse),
-                    f4(m[0].r2),
-                    f4(m[1].mse),
-                    f4(m[1].r2),
-                    paper,
-                ]);
-                pts.push((snr, 0.5 * (m[0].r2 + m[1].r2)));
-            }
-            series.push(Series {
-                label: kind.name().into(),
-                points: pts,
-            });
+fn read_log(dir: &Path) -> Vec<EpochLog> {
+    crate::io::read_text(&dir.join("train_log.jsonl"))
+        .map(|t| {
+            t.lines()
+                .filter_map(|l| serde_json::from_str(l).ok())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Runs the experiments `which` (each expanded by [`Which::parts`], in order, without
+/// repeats); returns the path of `index.html`.
+pub fn run(
+    which: &[Which],
+    opts: &ExperimentOptions,
+    log: &mut dyn FnMut(String),
+) -> Result<PathBuf> {
+    let t0 = Instant::now();
+    let plan = Plan::load(&opts.plan)?;
+    let data_dir = opts.out.join("data");
+    let mut parts: Vec<Which> = Vec::new();
+    for p in which.iter().flat_map(|w| w.parts()) {
+        if !parts.contains(&p) {
+            parts.push(p);
         }
-        let stem = if proto == NoiseProtocol::Matched {
-            "r2_vs_snr_matched.svg"
-        } else {
-            "r2_vs_snr_train_clean.svg"
-        };
-        charts.push((
-            format!("Mean test R² of FL and FQ against SNR ({label})"),
-            Chart {
-                title: format!("R² vs SNR: {label}"),
-                x_label: "SNR (dB, log scale)".into(),
-                y_label: "test R² (mean of FL, FQ)".into(),
-                log_x: true,
-                y_range: None,
-                series,
-            },
-            stem.to_string(),
+    }
+    log(format!(
+        "simulating {} condition(s) of {} into {} (resumable) …",
+        plan.conditions.len(),
+        plan.name,
+        data_dir.display()
+    ));
+    let gopts = GenerateOptions {
+        out: data_dir.clone(),
+        format: Format::Npz,
+        jobs: opts.jobs.max(1),
+        shard: None,
+        noise: None,
+        settle: 3.0,
+    };
+    generate(&plan, &gopts, &|_| {})?;
+    let candidates = if parts.contains(&Which::Sensors) {
+        Candidates::Onboard
+    } else {
+        Candidates::Paper21
+    };
+    let ds = slim(&DataSet::load(&data_dir)?, candidates)?;
+    let split = opts.split.clone().unwrap_or_else(|| Split::standard(&ds));
+    split.check()?;
+    if !matches!(split, Split::Seeds { .. }) {
+        log(format!(
+            "note: the plan has {} seed(s); testing on independent runs needs three or more (split: {})",
+            ds.seeds().len(),
+            split.describe()
         ));
     }
-    Ok(Section {
-        title: format!("3. Robustness to noise on {} (paper Fig. 8)", opts.condition),
-        text: vec![
-            "White Gaussian noise per input channel, σ = rms·10^(−SNR/20), seeded; labels never noised. Two protocols: (i) trained on clean inputs, tested on noisy ones; (ii) trained and tested at the same SNR (the paper's reading). The paper's R² at 1 dB is shown beside protocol (ii).".into(),
-        ],
-        tables: vec![("Test metrics against SNR".into(), t, "robustness".into())],
-        figures: charts,
-    })
+    let manifest_hash = crate::dataset::file_hash(&data_dir.join("manifest.json"))?;
+    let conditions: Vec<String> = plan.conditions.iter().map(|c| c.name.clone()).collect();
+    if parts
+        .iter()
+        .any(|p| matches!(p, Which::Comparison | Which::Robustness))
+        && !conditions.contains(&opts.condition)
+    {
+        return Err(Error::Domain(format!(
+            "condition {} is not in the plan {}",
+            opts.condition,
+            opts.plan.display()
+        )));
+    }
+    let runs = ds.runs.len();
+    let mut ctx = Ctx {
+        opts,
+        log,
+        ds,
+        split: split.clone(),
+        conditions,
+        pooled: None,
+    };
+    let mut sections: Vec<(String, Section)> = Vec::new();
+    let mut timings = serde_json::Map::new();
+    for part in parts.clone() {
+        let ts = Instant::now();
+        let sec = match part {
+            Which::Comparison => comparison::run(&mut ctx)?,
+            Which::Generalization => generalization::run(&mut ctx)?,
+            Which::Robustness => robustness::run(&mut ctx)?,
+            Which::Protocols => protocols::run(&mut ctx)?,
+            _ => sensors::run(&mut ctx)?,
+        };
+        let folder = part.folder();
+        sec.write_files(&opts.out.join(folder))?;
+        sections.push((folder.into(), sec));
+        timings.insert(format!("{folder}_s"), json!(ts.elapsed().as_secs_f64()));
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let meta = json!({
+        "plan": opts.plan.display().to_string(),
+        "plan_name": plan.name,
+        "data_manifest_fnv1a": manifest_hash,
+        "runs": runs,
+        "snr_db": opts.snr_db,
+        "noise": opts.noise(opts.snr_db),
+        "noise_definition": opts.noise(opts.snr_db).describe(),
+        "split": split,
+        "split_description": split.describe(),
+        "condition": opts.condition,
+        "training": opts.train,
+        "condition_windows_per_epoch": opts.condition_windows_per_epoch,
+        "label_at": format!("{:?}", opts.label_at),
+        "window": opts.window,
+        "fresh_noise_every_epoch": opts.fresh_noise,
+        "railforce_version": env!("CARGO_PKG_VERSION"),
+        "wall_seconds": wall,
+        "timings": timings,
+    });
+    let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");
+    crate::io::write_atomic(&opts.out.join("meta.json"), |w| w.write_all(mj.as_bytes()))?;
+    let intro = vec![
+        format!(
+            "railforce {} — plan {} ({} runs, data manifest {}), training seed {}, wall time {:.0} s.",
+            env!("CARGO_PKG_VERSION"),
+            plan.name,
+            runs,
+            manifest_hash,
+            opts.train.seed,
+            wall
+        ),
+        ctx.protocol(&split, Some(opts.snr_db)),
+        "Paper numbers come from another simulator and an unstated (apparently shuffled) split: a bar, not a target to match digit for digit.".into(),
+        format!(
+            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch ({} on one condition), validation on at most {} windows{}; classical models on at most {} windows.",
+            opts.train.lr,
+            opts.train.batch,
+            opts.train.epochs,
+            opts.train.patience,
+            opts.train
+                .windows_per_epoch
+                .map(|w| w.to_string())
+                .unwrap_or("all".into()),
+            opts.condition_windows_per_epoch,
+            opts.train
+                .val_windows
+                .map(|w| w.to_string())
+                .unwrap_or("all".into()),
+            if opts.fresh_noise {
+                "; networks trained at an SNR draw new input noise every epoch (validation and test keep one fixed, seeded realisation)"
+            } else {
+                "; networks trained on one fixed noise realisation"
+            },
+            opts.train.classical_rows
+        ),
+    ];
+    write_index(
+        &opts.out,
+        "railforce: wheel–rail force identification experiments",
+        &intro,
+        &sections,
+    )?;
+    Ok(opts.out.join("index.html"))
 }

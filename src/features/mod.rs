@@ -11,7 +11,7 @@ pub use samples::{
 };
 
 use crate::error::{Error, Result};
-use crate::sim::output::PAPER_CHANNELS;
+use crate::sensors::{Candidates, noisy_name};
 use serde::{Deserialize, Serialize};
 
 /// One row of the selection table.
@@ -67,6 +67,11 @@ pub struct SelectOptions {
     pub label_at: LabelAt,
     /// Largest number of rows the MI estimator sees (evenly strided).
     pub mi_samples: usize,
+    /// Largest number of training windows the wrapper's ridge sees (evenly strided; the
+    /// validation windows at most half as many).
+    pub max_windows: usize,
+    /// The signals to choose from.
+    pub candidates: Candidates,
 }
 
 impl Default for SelectOptions {
@@ -79,39 +84,42 @@ impl Default for SelectOptions {
             window: 20,
             label_at: LabelAt::Last,
             mi_samples: 50_000,
+            max_windows: 40_000,
+            candidates: Candidates::Paper21,
         }
     }
 }
 
-/// Resolves `FL`/`FQ` to the label channels.
-pub fn target_channel(target: &str) -> String {
-    match target {
-        "FL" => "w1l_force_y".into(),
-        "FQ" => "w1l_force_z".into(),
-        other => other.to_string(),
-    }
-}
-
-/// Filter (MI of each of the 21 inputs with the target over the training rows), then
-/// wrapper (forward selection by validation R² of ridge on flattened windows).
+/// Filter (MI of each candidate with the target over the training rows, spec learning.md §2),
+/// then wrapper (forward selection by validation R² of ridge on flattened windows).
 pub fn select(ds: &DataSet, split: &Split, opts: &SelectOptions) -> Result<Selection> {
-    let target_name = target_channel(&opts.target);
+    let target_name = ds.target_channel(&opts.target);
     let target = ds.channel(&target_name)?;
-    let names: Vec<String> = PAPER_CHANNELS
+    let names: Vec<String> = opts
+        .candidates
+        .among(&ds.names, &ds.labels)
         .iter()
-        .map(|c| {
-            if opts.noisy {
-                format!("{c}_noisy")
-            } else {
-                c.to_string()
-            }
-        })
+        .map(|c| if opts.noisy { noisy_name(c) } else { c.clone() })
         .collect();
+    if names.is_empty() {
+        return Err(Error::Domain(format!(
+            "{} has no {} candidate channels",
+            ds.dir.display(),
+            opts.candidates.name()
+        )));
+    }
     let inputs = names
         .iter()
         .map(|n| ds.channel(n))
         .collect::<Result<Vec<_>>>()?;
-    let samples = Samples::build(ds, split, opts.window, 2, opts.label_at)?;
+    let mut samples = Samples::build(ds, split, opts.window, 2, opts.label_at)?;
+    for (part, cap) in [
+        (&mut samples.train, opts.max_windows),
+        (&mut samples.val, opts.max_windows / 2),
+    ] {
+        let step = part.len().div_ceil(cap.max(1)).max(1);
+        *part = part.iter().step_by(step).copied().collect();
+    }
     if samples.train.is_empty() || samples.val.is_empty() {
         return Err(Error::Domain(
             "the split leaves no training or validation windows".into(),

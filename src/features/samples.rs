@@ -1,10 +1,13 @@
-//! Leak-free samples (spec learning.md §1): split first, window second. Each run is cut into
-//! contiguous blocks (default 70/15/15 % train/validation/test), or whole conditions are held
-//! out; windows of `window` steps never cross a block boundary; windows are indices into the
-//! runs, not copies. Z-score statistics come from the training rows only.
+//! Samples (spec learning.md §1): split first, window second. The default test is a set of
+//! independent runs: whole runs of irregularity seeds the model never saw ([`Split::Seeds`]).
+//! Runs can also be cut into contiguous blocks, whole conditions held out, or (labelled as
+//! leaky, for comparison only) stride-1 windows shuffled. Windows of `window` steps never
+//! cross a block boundary; windows are indices into the runs, not copies. Z-score statistics
+//! come from the training rows only.
 
 use crate::dataset::{npz, parquet_file};
 use crate::error::{Error, Result};
+use crate::sensors::{NoiseModel, SnrReference, label_channels};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -40,14 +43,108 @@ pub struct DataSet {
     pub names: Vec<String>,
     /// Runs in manifest order.
     pub runs: Vec<Run>,
+    /// The label channels FL and FQ (the vehicle's label wheel, manifest
+    /// `conventions.labels`; `w1l_force_y`/`w1l_force_z` where it says nothing).
+    pub labels: [String; 2],
+    /// The noise of the `_noisy` copies, as the manifest records it (`None`: clean data).
+    pub noise: Option<NoiseModel>,
 }
 
 impl DataSet {
-    /// The SNR of the noisy input copies, dB, as the manifest records it (`None` for a clean
-    /// data set or one held only in memory).
+    /// The SNR of the noisy input copies, dB (`None` for a clean data set).
     pub fn snr_db(&self) -> Option<f64> {
-        let text = crate::io::read_text(&self.dir.join("manifest.json")).ok()?;
-        serde_json::from_str::<serde_json::Value>(&text).ok()?["snr_db"].as_f64()
+        self.noise.map(|n| n.snr_db)
+    }
+
+    /// A data set held in memory, clean, labelled on wheel 1L.
+    pub fn in_memory(dir: &Path, names: Vec<String>, runs: Vec<Run>) -> Self {
+        DataSet {
+            dir: dir.to_path_buf(),
+            names,
+            runs,
+            labels: label_channels("1L"),
+            noise: None,
+        }
+    }
+
+    /// Resolves `FL`/`FQ` to this data set's label channels; any other name is a channel.
+    pub fn target_channel(&self, target: &str) -> String {
+        match target {
+            "FL" => self.labels[0].clone(),
+            "FQ" => self.labels[1].clone(),
+            other => other.to_string(),
+        }
+    }
+
+    /// A copy with `<channel>_noisy` copies of `channels` drawn with `noise` (replacing any
+    /// noisy columns), seeded by each run's seed and channel name: the same noise
+    /// `railforce generate --snr-db` writes.
+    pub fn with_noise(&self, noise: NoiseModel, channels: &[String]) -> Result<DataSet> {
+        let keep: Vec<usize> = (0..self.names.len())
+            .filter(|&i| !crate::sensors::is_noisy(&self.names[i]))
+            .collect();
+        let base = channels
+            .iter()
+            .map(|c| self.channel(c))
+            .collect::<Result<Vec<_>>>()?;
+        let mut out = DataSet {
+            names: keep.iter().map(|&i| self.names[i].clone()).collect(),
+            runs: Vec::with_capacity(self.runs.len()),
+            noise: Some(noise),
+            ..self.clone_empty()
+        };
+        out.names
+            .extend(channels.iter().map(|c| crate::sensors::noisy_name(c)));
+        for run in &self.runs {
+            let mut cols: Vec<Vec<f64>> = keep.iter().map(|&i| run.columns[i].clone()).collect();
+            for (&c, name) in base.iter().zip(channels) {
+                cols.push(noise.apply(&run.columns[c], run.seed, name));
+            }
+            out.runs.push(Run {
+                condition: run.condition.clone(),
+                seed: run.seed,
+                columns: cols,
+            });
+        }
+        Ok(out)
+    }
+
+    /// The runs whose condition is in `conditions`, and only the columns `channels`.
+    pub fn subset(&self, conditions: Option<&[String]>, channels: Option<&[String]>) -> Result<DataSet> {
+        let idx: Vec<usize> = match channels {
+            Some(c) => c.iter().map(|n| self.channel(n)).collect::<Result<_>>()?,
+            None => (0..self.names.len()).collect(),
+        };
+        Ok(DataSet {
+            names: idx.iter().map(|&i| self.names[i].clone()).collect(),
+            runs: self
+                .runs
+                .iter()
+                .filter(|r| conditions.is_none_or(|c| c.contains(&r.condition)))
+                .map(|r| Run {
+                    condition: r.condition.clone(),
+                    seed: r.seed,
+                    columns: idx.iter().map(|&i| r.columns[i].clone()).collect(),
+                })
+                .collect(),
+            ..self.clone_empty()
+        })
+    }
+
+    fn clone_empty(&self) -> DataSet {
+        DataSet {
+            dir: self.dir.clone(),
+            names: Vec::new(),
+            runs: Vec::new(),
+            labels: self.labels.clone(),
+            noise: self.noise,
+        }
+    }
+
+    /// The distinct seeds of the runs, ascending.
+    pub fn seeds(&self) -> Vec<u64> {
+        let s: std::collections::BTreeSet<u64> = self.runs.iter().map(|r| r.seed).collect();
+        s.into_iter().collect()
     }
 
     /// Reads `manifest.json` and every run file it lists (npz, parquet or csv).
@@ -84,10 +181,27 @@ impl DataSet {
                 columns: cols.into_iter().map(|(_, v)| v).collect(),
             });
         }
+        let labels = match (
+            m["conventions"]["labels"]["FL"].as_str(),
+            m["conventions"]["labels"]["FQ"].as_str(),
+        ) {
+            (Some(fl), Some(fq)) => [fl.to_string(), fq.to_string()],
+            _ => label_channels("1L"),
+        };
+        let noise = m["snr_db"].as_f64().map(|snr| {
+            let reference = match m["snr_reference"].as_str() {
+                Some(r) => SnrReference::parse(r).unwrap_or_default(),
+                // Data sets written before the reference was recorded used the rms.
+                None => SnrReference::Rms,
+            };
+            NoiseModel::new(snr, reference)
+        });
         Ok(DataSet {
             dir: dir.to_path_buf(),
             names: names.unwrap_or_default(),
             runs,
+            labels,
+            noise,
         })
     }
 
@@ -164,6 +278,26 @@ pub enum LabelAt {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Split {
+    /// Whole runs by irregularity seed (the default, spec learning.md §1.1): a seed never
+    /// serves two parts; the test runs are independent stretches of track.
+    Seeds {
+        /// Training seeds.
+        train: Vec<u64>,
+        /// Validation seeds.
+        val: Vec<u64>,
+        /// Test seeds.
+        test: Vec<u64>,
+    },
+    /// Stride-1 windows of whole runs shuffled into parts. Leaky (neighbouring windows share
+    /// all but one step): it exists only to show what such a protocol reports.
+    Shuffled {
+        /// Training fraction.
+        train: f64,
+        /// Validation fraction.
+        val: f64,
+        /// Shuffling seed.
+        seed: u64,
+    },
     /// Contiguous blocks of every run: the first `train`, then `val`, the rest test.
     Blocks {
         /// Training fraction.
@@ -187,11 +321,98 @@ pub enum Split {
     },
 }
 
+/// 70/15/15 % contiguous blocks: the split every data set allows, even with one seed.
 impl Default for Split {
     fn default() -> Self {
         Split::Blocks {
             train: 0.70,
             val: 0.15,
+        }
+    }
+}
+
+impl Split {
+    /// The protocol's default for a data set (spec learning.md §1.1): by seed when it has at
+    /// least three (the last tests, the one before validates, the rest train), else
+    /// 70/15/15 % blocks (say so: a data set of one seed cannot test on independent runs).
+    pub fn standard(ds: &DataSet) -> Split {
+        let seeds = ds.seeds();
+        if seeds.len() >= 3 {
+            let n = seeds.len();
+            Split::Seeds {
+                train: seeds[..n - 2].to_vec(),
+                val: vec![seeds[n - 2]],
+                test: vec![seeds[n - 1]],
+            }
+        } else {
+            Split::default()
+        }
+    }
+
+    /// Checks a seed split: no seed in two parts, every part non-empty.
+    pub fn check(&self) -> Result<()> {
+        if let Split::Seeds { train, val, test } = self {
+            for (a, an, b, bn) in [
+                (train, "train", val, "validation"),
+                (train, "train", test, "test"),
+                (val, "validation", test, "test"),
+            ] {
+                if let Some(s) = a.iter().find(|s| b.contains(s)) {
+                    return Err(Error::Domain(format!(
+                        "seed {s} is in both the {an} and the {bn} seeds: a seed never serves two parts"
+                    )));
+                }
+            }
+            if train.is_empty() || test.is_empty() {
+                return Err(Error::Domain(
+                    "a seed split needs at least one training and one test seed".into(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Short name: `seeds`, `blocks`, `conditions`, `runs` or `shuffled`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Split::Seeds { .. } => "seeds",
+            Split::Blocks { .. } => "blocks",
+            Split::Runs { .. } => "runs",
+            Split::Conditions { .. } => "conditions",
+            Split::Shuffled { .. } => "shuffled",
+        }
+    }
+
+    /// One line for tables and reports.
+    pub fn describe(&self) -> String {
+        let list = |v: &[u64]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ");
+        match self {
+            Split::Seeds { train, val, test } => format!(
+                "by seed: train on seeds {}, validate on {}, test on whole runs of seed {} (independent track irregularities)",
+                list(train),
+                list(val),
+                list(test)
+            ),
+            Split::Blocks { train, val } => format!(
+                "blocks: each run cut into contiguous {:.0}/{:.0}/{:.0} % train/validation/test blocks (the test block is the end of each run)",
+                100.0 * train,
+                100.0 * val,
+                100.0 * (1.0 - train - val)
+            ),
+            Split::Runs { val, test } => {
+                format!("whole runs held out: validation {val:?}, test {test:?}")
+            }
+            Split::Conditions { val, test } => format!(
+                "whole conditions held out: test {}, validation {}",
+                test.join(", "),
+                val.join(", ")
+            ),
+            Split::Shuffled { train, val, .. } => format!(
+                "SHUFFLED (leaky): stride-1 windows shuffled {:.0}/{:.0}/{:.0} % into train/validation/test; neighbouring windows share all but one step, so the test is not independent",
+                100.0 * train,
+                100.0 * val,
+                100.0 * (1.0 - train - val)
+            ),
         }
     }
 }
@@ -249,10 +470,29 @@ impl Samples {
         if window == 0 || stride == 0 {
             return Err(Error::Domain("window and stride must be at least 1".into()));
         }
+        split.check()?;
+        if let Split::Shuffled { train, val, seed } = split {
+            return Self::shuffled(ds, window, label_at, *train, *val, *seed);
+        }
         let (mut tr, mut va, mut te) = (Vec::new(), Vec::new(), Vec::new());
         for (i, run) in ds.runs.iter().enumerate() {
             let n = run.len();
             match split {
+                Split::Shuffled { .. } => unreachable!("handled above"),
+                Split::Seeds { train, val, test } => {
+                    let block = Block {
+                        run: i,
+                        from: 0,
+                        to: n,
+                    };
+                    if test.contains(&run.seed) {
+                        te.push(block);
+                    } else if val.contains(&run.seed) {
+                        va.push(block);
+                    } else if train.contains(&run.seed) {
+                        tr.push(block);
+                    }
+                }
                 Split::Blocks { train, val } => {
                     if !(*train > 0.0 && *val >= 0.0 && train + val < 1.0) {
                         return Err(Error::Domain(format!(
@@ -330,6 +570,52 @@ impl Samples {
             train_blocks: tr,
             val_blocks: va,
             test_blocks: te,
+        })
+    }
+
+    /// Stride-1 windows of whole runs, shuffled into the parts (leaky: for comparison only).
+    fn shuffled(
+        ds: &DataSet,
+        window: usize,
+        label_at: LabelAt,
+        train: f64,
+        val: f64,
+        seed: u64,
+    ) -> Result<Self> {
+        use rand::seq::SliceRandom;
+        if !(train > 0.0 && val >= 0.0 && train + val < 1.0) {
+            return Err(Error::Domain(format!(
+                "shuffled fractions must satisfy 0 < train, 0 ≤ val, train + val < 1 (got {train}, {val})"
+            )));
+        }
+        let blocks: Vec<Block> = (0..ds.runs.len())
+            .map(|i| Block {
+                run: i,
+                from: 0,
+                to: ds.runs[i].len(),
+            })
+            .collect();
+        let mut all = Vec::new();
+        for b in &blocks {
+            for s in (b.from..).take_while(|s| s + window <= b.to) {
+                all.push(Window {
+                    run: b.run as u32,
+                    start: s as u32,
+                });
+            }
+        }
+        all.shuffle(&mut crate::sensors::noise::rng(seed, 0x5348_5546));
+        let a = (all.len() as f64 * train).round() as usize;
+        let b = (all.len() as f64 * (train + val)).round() as usize;
+        Ok(Samples {
+            window,
+            label_at,
+            test: all[b..].to_vec(),
+            val: all[a..b].to_vec(),
+            train: all[..a].to_vec(),
+            train_blocks: blocks,
+            val_blocks: Vec::new(),
+            test_blocks: Vec::new(),
         })
     }
 

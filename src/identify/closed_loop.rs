@@ -6,7 +6,7 @@ use super::safety::{Limits, indices};
 use super::{Identified, SensorTable, check, identify};
 use crate::dataset::{Format, GenerateOptions, generate};
 use crate::error::{Error, Result};
-use crate::features::DataSet;
+use crate::features::{DataSet, NoiseProtocol};
 use crate::learn::model::Model;
 use crate::learn::windows::label_offset;
 use crate::plan::Plan;
@@ -70,13 +70,18 @@ pub fn validate(
     for c in &mut plan.conditions {
         c.seeds = vec![seed];
     }
-    let snr_db = model.meta.data_identity["snr_db"].as_f64();
+    // The inputs at the noise the model was trained and tested with (its SNR and reference),
+    // clean for a clean model.
+    let noise = match model.meta.data.noise {
+        NoiseProtocol::Clean => None,
+        _ => model.meta.data.noise_model,
+    };
     let opts = GenerateOptions {
         out: work.to_path_buf(),
         format: Format::Npz,
         jobs: jobs.max(1),
         shard: None,
-        snr_db,
+        noise,
         settle: 3.0,
     };
     generate(&plan, &opts, &|_| {})?;

@@ -9,6 +9,7 @@ use super::neural::{Adam, NetConfig, Network};
 use super::windows::{DataSpec, NoiseRefresher, WindowSet, prepare};
 use crate::error::{Error, Result};
 use crate::features::{DataSet, NoiseProtocol};
+use crate::sensors::NoiseModel;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
@@ -38,10 +39,13 @@ pub struct TrainOptions {
     pub classical_rows: usize,
     /// Continue from the checkpoint in the output folder.
     pub resume: bool,
-    /// Matched protocol only: draw new training-input noise at this SNR (dB) every epoch
+    /// Matched protocol only: draw new training-input noise with this model every epoch
     /// instead of reading the data set's one fixed noisy copy (validation and test keep it).
     #[serde(default)]
-    pub fresh_noise_snr_db: Option<f64>,
+    pub fresh_noise: Option<NoiseModel>,
+    /// Validation windows scored each epoch at most (evenly strided; all when `None`).
+    #[serde(default)]
+    pub val_windows: Option<usize>,
 }
 
 impl Default for TrainOptions {
@@ -56,7 +60,8 @@ impl Default for TrainOptions {
             windows_per_epoch: None,
             classical_rows: 40_000,
             resume: false,
-            fresh_noise_snr_db: None,
+            fresh_noise: None,
+            val_windows: None,
         }
     }
 }
@@ -133,7 +138,11 @@ pub fn train(
         ));
     }
     let t0 = Instant::now();
-    let prep = prepare(ds, spec, None)?;
+    let mut prep = prepare(ds, spec, None)?;
+    if let Some(cap) = opts.val_windows {
+        let step = prep.val.len().div_ceil(cap.max(1)).max(1);
+        prep.val.windows = prep.val.windows.iter().step_by(step).copied().collect();
+    }
     if prep.train.is_empty() || prep.val.is_empty() {
         return Err(Error::Domain(format!(
             "the split leaves {} training and {} validation windows: need both",
@@ -141,15 +150,15 @@ pub fn train(
             prep.val.len()
         )));
     }
-    let refresher = match opts.fresh_noise_snr_db {
-        Some(snr) if kind.architecture().is_some() => {
+    let refresher = match &opts.fresh_noise {
+        Some(noise) if kind.architecture().is_some() => {
             if spec.noise != NoiseProtocol::Matched {
                 return Err(Error::Domain(format!(
                     "fresh noise every epoch needs the matched noise protocol (train and test at the same SNR), not {:?}",
                     spec.noise
                 )));
             }
-            Some(NoiseRefresher::new(ds, spec, &prep.input_stats, snr)?)
+            Some(NoiseRefresher::new(ds, spec, &prep.input_stats, noise)?)
         }
         _ => None,
     };
@@ -161,11 +170,19 @@ pub fn train(
         "seeds": ds.runs.iter().map(|r| r.seed).collect::<std::collections::BTreeSet<_>>(),
         "conditions": ds.runs.iter().map(|r| r.condition.clone()).collect::<std::collections::BTreeSet<_>>(),
         "snr_db": ds.snr_db(),
+        "split": spec.split.describe(),
     });
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let mut meta = ModelMeta {
         kind,
-        data: spec.clone(),
+        data: DataSpec {
+            // The noise the model met: the data set's (noisy columns) or the fresh draws.
+            noise_model: spec.noise_model.or(match spec.noise {
+                NoiseProtocol::Clean => None,
+                _ => opts.fresh_noise.or(ds.noise),
+            }),
+            ..spec.clone()
+        },
         input_stats: prep.input_stats.clone(),
         target_stats: prep.target_stats.clone(),
         net: None,
@@ -268,7 +285,7 @@ fn train_network(
             opts.batch,
             opts.lr,
             opts.windows_per_epoch,
-            opts.fresh_noise_snr_db,
+            opts.fresh_noise,
         ))
         .expect("serialises")
         .as_bytes(),

@@ -5,6 +5,8 @@
 
 use crate::error::{Error, Result};
 use crate::features::{DataSet, LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
+use crate::sensors::NoiseModel;
+use crate::sensors::noise::rng;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -28,6 +30,10 @@ pub struct DataSpec {
     pub split: Split,
     /// Which inputs each part reads.
     pub noise: NoiseProtocol,
+    /// The noise of the noisy inputs (SNR and its reference), when any part reads them or
+    /// training draws fresh noise; `None` for a clean model.
+    #[serde(default)]
+    pub noise_model: Option<NoiseModel>,
 }
 
 /// Windows of one part.
@@ -209,7 +215,7 @@ pub fn prepare(
 }
 
 /// Fresh input noise for the training windows, one draw per epoch (matched protocol): the
-/// clean inputs plus white Gaussian noise with `σ_c = rms_c · 10^(−SNR/20)` per run and
+/// clean inputs plus white Gaussian noise with the σ of [`NoiseModel::sigma`] per run and
 /// channel, exactly the data set's noise model (spec learning.md §1.4), in the training
 /// view's standardisation. A network trained on one fixed noise realisation learns that
 /// realisation (the training loss keeps falling while the validation loss stalls); a new
@@ -224,11 +230,12 @@ pub struct NoiseRefresher {
 }
 
 impl NoiseRefresher {
-    /// Noise at `snr_db` for the inputs of `spec` with the training statistics `stats`.
-    pub fn new(ds: &DataSet, spec: &DataSpec, stats: &ZScore, snr_db: f64) -> Result<Self> {
-        if !snr_db.is_finite() {
+    /// Noise of `model` for the inputs of `spec` with the training statistics `stats`.
+    pub fn new(ds: &DataSet, spec: &DataSpec, stats: &ZScore, model: &NoiseModel) -> Result<Self> {
+        if !model.snr_db.is_finite() {
             return Err(Error::Domain(format!(
-                "the SNR of fresh noise must be finite, got {snr_db}"
+                "the SNR of fresh noise must be finite, got {}",
+                model.snr_db
             )));
         }
         let cols = spec
@@ -248,7 +255,7 @@ impl NoiseRefresher {
                 cols.iter()
                     .enumerate()
                     .map(|(k, &c)| {
-                        (crate::dataset::noise_sigma(&r.columns[c], snr_db) / stats.std[k]) as f32
+                        (model.sigma(&r.columns[c]) / stats.std[k]) as f32
                     })
                     .collect()
             })
@@ -258,8 +265,6 @@ impl NoiseRefresher {
 
     /// A new noisy copy of the inputs, determined by `seed`.
     pub fn draw(&self, seed: u64) -> Arc<Vec<Vec<f32>>> {
-        use rand_chacha::ChaCha8Rng;
-        use rand_chacha::rand_core::SeedableRng;
         use rand_distr::{Distribution, StandardNormal};
         Arc::new(
             self.clean
@@ -267,9 +272,7 @@ impl NoiseRefresher {
                 .zip(&self.sigma)
                 .enumerate()
                 .map(|(r, (x, sig))| {
-                    let mut rng = ChaCha8Rng::seed_from_u64(
-                        seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ r as u64,
-                    );
+                    let mut rng = rng(seed, r as u64);
                     let mut out = Vec::with_capacity(x.len());
                     for row in x.chunks_exact(sig.len()) {
                         for (v, s) in row.iter().zip(sig) {

@@ -12,40 +12,11 @@
 use super::filter::Lowpass;
 use super::{Simulation, wheel_name};
 use crate::error::{Error, Result};
+use crate::sensors::{PAPER_CHANNELS, PAPER_UNITS};
 use crate::vehicle::Accelerometers;
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-
-/// Names of the paper's 21 input channels, in order X1 … X21 (spec §5).
-pub const PAPER_CHANNELS: [&str; 21] = [
-    "frame_l_acc_y",
-    "frame_r_acc_y",
-    "frame_l_acc_z",
-    "frame_r_acc_z",
-    "bolster_acc_y",
-    "bolster_acc_z",
-    "ws1_acc_y",
-    "ws1_acc_z",
-    "ws1_y_rel",
-    "ws1_yaw",
-    "ws1_roll",
-    "body_roll_rate",
-    "body_pitch_rate",
-    "body_yaw_rate",
-    "ws1_roll_rate",
-    "ws1_pitch_rate",
-    "ws1_yaw_rate",
-    "ws1_attack_angle",
-    "w1l_creep_y",
-    "w1l_creep_x",
-    "w1l_creep_spin",
-];
-
-const PAPER_UNITS: [&str; 21] = [
-    "m/s2", "m/s2", "m/s2", "m/s2", "m/s2", "m/s2", "m/s2", "m/s2", "m", "rad", "rad", "rad/s",
-    "rad/s", "rad/s", "rad/s", "rad/s", "rad/s", "rad", "1", "1", "1/m",
-];
 
 const BODY_SIGNALS: [(&str, &str); 10] = [
     ("acc_x", "m/s2"),
@@ -105,6 +76,12 @@ impl Recorder {
             for (s, u) in BODY_SIGNALS {
                 names.push(format!("{}_{s}", b.name));
                 units.push(u);
+            }
+        }
+        for e in &v.elements {
+            for (name, _) in e.gauges(&v.bodies) {
+                names.push(name);
+                units.push("m");
             }
         }
         let cfg = sim.config();
@@ -200,6 +177,8 @@ fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
             .position(|&w| w == sl.wheelset)
             .unwrap_or(0);
         let wl = &sim.wheels[2 * ws_pos];
+        // The angle of attack and the creepages are those of the label wheel (1L: the paper's).
+        let lw = &sim.wheels[sl.label_wheel];
         let (fl, fr, bo, cb, ws) = (
             &body_vals[sl.frame_left],
             &body_vals[sl.frame_right],
@@ -225,10 +204,10 @@ fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
             ws[3],
             ws[4],
             ws[5],
-            wl.yaw - wl.rail_slope,
-            wl.creepage.y,
-            wl.creepage.x,
-            wl.creepage.spin,
+            lw.yaw - lw.rail_slope,
+            lw.creepage.y,
+            lw.creepage.x,
+            lw.creepage.spin,
         ] {
             put(x);
         }
@@ -249,6 +228,13 @@ fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
     for b in &body_vals {
         for &x in b {
             put(x);
+        }
+    }
+    for e in &v.elements {
+        if let Some(d) = e.deflection(states) {
+            for (_, axis) in e.gauges(&v.bodies) {
+                put(d[axis]);
+            }
         }
     }
     let _ = paper;

@@ -289,6 +289,13 @@ pub struct Vehicle {
 }
 
 impl Vehicle {
+    /// The wheel whose forces are the labels, `1L` … (the sensor layout's `label_wheel`; 1L,
+    /// the paper's, for a vehicle without one).
+    pub fn label_wheel_name(&self) -> String {
+        let k = self.sensors.as_ref().map_or(0, |s| s.label_wheel);
+        format!("{}{}", k / 2 + 1, if k % 2 == 0 { 'L' } else { 'R' })
+    }
+
     /// Total mass, kg.
     pub fn mass(&self) -> f64 {
         self.bodies.iter().map(|b| b.mass).sum()

@@ -69,7 +69,8 @@ impl ClassicalParams {
             c: 1.0,
             epsilon: 0.1,
             max_samples: 4000,
-            max_sweeps: 200,
+            max_sweeps: 5000,
+            tol: 1e-3,
         })
     }
 }
@@ -141,6 +142,12 @@ impl Classical {
                 let svrs = (0..outputs)
                     .map(|k| {
                         let s = Svr::fit(&xs, f, &column(k, &rows), &sp);
+                        if !s.converged {
+                            eprintln!(
+                                "warning: SVR output {k} stopped at the cap of {} sweeps before reaching its tolerance {}",
+                                sp.max_sweeps, sp.tol
+                            );
+                        }
                         progress(k + 1, outputs);
                         s
                     })

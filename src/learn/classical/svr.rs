@@ -1,8 +1,11 @@
 //! ε-support-vector regression with an RBF kernel `k(a, b) = exp(−γ‖a − b‖²)`, exact on a
 //! subsample of the training windows (the kernel matrix is n², so the full 285 k windows would
-//! not fit). Solved in the dual by coordinate descent without the bias term (Ho & Lin 2012,
-//! the LIBLINEAR ε-SVR solver, here with a precomputed kernel): minimise
-//! `½βᵀKβ − yᵀβ + ε‖β‖₁` subject to `|β_i| ≤ C`; the mean of the targets is the offset.
+//! not fit). Solved in the dual by coordinate descent (Ho & Lin 2012, the LIBLINEAR ε-SVR
+//! solver, here with a precomputed kernel): minimise `½βᵀ(K + 1)βᵀ − tᵀβ + ε‖β‖₁` subject to
+//! `|β_i| ≤ C`, with `t` the targets less their mean. The `+ 1` is the bias feature of
+//! LIBLINEAR (B = 1): it fits the intercept `b = Σβ_i` beside the mean offset. Sweeps run
+//! until no coordinate moves the objective's gradient by more than the tolerance (scikit-
+//! learn's `tol = 1e-3`), or to the cap, which is reported.
 
 use crate::learn::linalg::gemm;
 use serde::{Deserialize, Serialize};
@@ -18,6 +21,13 @@ pub struct SvrParams {
     pub max_samples: usize,
     /// Coordinate-descent sweeps at most.
     pub max_sweeps: usize,
+    /// Stopping tolerance on the largest coordinate step times its curvature.
+    #[serde(default = "default_tol")]
+    pub tol: f64,
+}
+
+fn default_tol() -> f64 {
+    1e-3
 }
 
 /// A fitted SVR: support vectors (rows with β ≠ 0), their coefficients, γ, offset.
@@ -33,8 +43,11 @@ pub struct Svr {
     pub beta: Vec<f32>,
     /// Support vectors, row-major.
     pub sv: Vec<f32>,
-    /// Sweeps taken and final largest coefficient change (diagnostics).
+    /// Sweeps taken (diagnostics).
     pub sweeps: usize,
+    /// Whether the solver reached its tolerance before the sweep cap.
+    #[serde(default)]
+    pub converged: bool,
 }
 
 impl Svr {
@@ -46,14 +59,17 @@ impl Svr {
             x.iter().map(|&v| (v as f64 - mean_x).powi(2)).sum::<f64>() / x.len().max(1) as f64;
         let gamma = (1.0 / (f as f64 * var_x.max(1e-12))) as f32;
         let offset = (y.iter().map(|&v| v as f64).sum::<f64>() / n.max(1) as f64) as f32;
-        let k = kernel(x, x, n, n, f, gamma);
+        let mut k = kernel(x, x, n, n, f, gamma);
+        for v in &mut k {
+            *v += 1.0; // the bias feature
+        }
         let t: Vec<f64> = y.iter().map(|&v| (v - offset) as f64).collect();
         let mut beta = vec![0.0f64; n];
         let mut fx = vec![0.0f64; n]; // (Kβ)_i
-        let mut sweeps = 0;
+        let (mut sweeps, mut converged) = (0, false);
         for sweep in 0..p.max_sweeps {
             sweeps = sweep + 1;
-            let mut max_change = 0.0f64;
+            let mut max_step = 0.0f64;
             for i in 0..n {
                 let kii = k[i * n + i] as f64;
                 let g = fx[i] - t[i];
@@ -67,24 +83,27 @@ impl Svr {
                     for (fj, kj) in fx.iter_mut().zip(&k[i * n..(i + 1) * n]) {
                         *fj += d * *kj as f64;
                     }
-                    max_change = max_change.max(d.abs());
+                    max_step = max_step.max(d.abs() * kii);
                 }
             }
-            if max_change < 1e-4 {
+            if max_step < p.tol {
+                converged = true;
                 break;
             }
         }
         let keep: Vec<usize> = (0..n).filter(|&i| beta[i] != 0.0).collect();
+        let bias: f64 = beta.iter().sum();
         Svr {
             f,
             gamma,
-            offset,
+            offset: offset + bias as f32,
             beta: keep.iter().map(|&i| beta[i] as f32).collect(),
             sv: keep
                 .iter()
                 .flat_map(|&i| x[i * f..(i + 1) * f].iter().copied())
                 .collect(),
             sweeps,
+            converged,
         }
     }
 

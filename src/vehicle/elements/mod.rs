@@ -58,6 +58,47 @@ impl Element {
         }
     }
 
+    /// Relative displacement across the element from its static loaded position, in the upper
+    /// body's axes (lower attachment relative to the upper: `+z` compresses a supporting
+    /// element), for the kinds that carry a displacement gauge (spec physics.md §5).
+    pub fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
+        let (upper, lower) = self.attachments()?;
+        Some(Relative::new(upper, lower, states).d)
+    }
+
+    /// The displacement gauges across this element: channel name and axis (0 x, 1 y, 2 z) of
+    /// [`Element::deflection`]. Spring nests read vertical and lateral (`nest_<side frame>_z`,
+    /// `_y`), shear pads x, y, z (`pad_<side frame>_<wheelset>_x` …), side bearers vertical
+    /// (`sidebearer_<bolster>_<l|r>_z`), centre plates vertical (`centreplate_<bolster>_z`).
+    /// Vertical readings are positive in compression.
+    pub fn gauges(&self, bodies: &[super::body::Body]) -> Vec<(String, usize)> {
+        let Some((upper, lower)) = self.attachments() else {
+            return Vec::new();
+        };
+        let (u, l) = (&bodies[upper.body].name, &bodies[lower.body].name);
+        let side = if lower.local.y > 1e-3 { "l" } else { "r" };
+        let (stem, axes): (String, &[usize]) = match self {
+            Element::SpringNest(_) => (format!("nest_{l}"), &[2, 1]),
+            Element::ShearPad(_) => (format!("pad_{u}_{l}"), &[0, 1, 2]),
+            Element::SideBearer(_) => (format!("sidebearer_{l}_{side}"), &[2]),
+            Element::CentrePlate(_) => (format!("centreplate_{l}"), &[2]),
+            _ => return Vec::new(),
+        };
+        axes.iter()
+            .map(|&a| (format!("{stem}_{}", ["x", "y", "z"][a]), a))
+            .collect()
+    }
+
+    fn attachments(&self) -> Option<(&Attachment, &Attachment)> {
+        match self {
+            Element::ShearPad(e) => Some((&e.upper, &e.lower)),
+            Element::SpringNest(e) => Some((&e.upper, &e.lower)),
+            Element::CentrePlate(e) => Some((&e.upper, &e.lower)),
+            Element::SideBearer(e) => Some((&e.upper, &e.lower)),
+            _ => None,
+        }
+    }
+
     /// Kind name as in the vehicle file.
     pub fn kind(&self) -> &'static str {
         match self {

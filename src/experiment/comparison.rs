@@ -1,0 +1,171 @@
+//! Experiment 1 (paper Tables 2–3): the eight models on one condition, one model per target as
+//! the paper trains them, train and test MSE / R², training curves and identified-against-true
+//! traces of a whole test run.
+
+use super::{Ctx, f4, paper, read_log, train_metrics};
+use crate::error::Result;
+use crate::features::NoiseProtocol;
+use crate::learn::evaluate::{EvalPart, PredictionRow, evaluate};
+use crate::learn::model::ModelKind;
+use crate::report::Section;
+use crate::report::svg::{Chart, Series};
+use crate::report::table::Table;
+
+pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
+    let opts = ctx.opts;
+    let cond = std::slice::from_ref(&opts.condition);
+    let inputs = Ctx::paper21();
+    let dsc = ctx.noisy(&ctx.ds.subset(Some(cond), None)?, opts.snr_db, &inputs)?;
+    let dir = opts.out.join("comparison");
+    let mut tables: [Table; 2] = std::array::from_fn(|_| {
+        Table::new(&[
+            "model",
+            "train MSE",
+            "train R²",
+            "test MSE",
+            "test R²",
+            "Var(y_test)",
+            "test RMSE kN",
+            "fit s",
+            "paper train MSE / R²",
+            "paper test MSE / R²",
+        ])
+    });
+    let mut curves: [Vec<Series>; 2] = [Vec::new(), Vec::new()];
+    let mut traces: [Option<Vec<PredictionRow>>; 2] = [None, None];
+    let labels = ctx.labels();
+    for &kind in &opts.models {
+        for k in 0..2 {
+            let sp = ctx.spec(
+                &inputs,
+                std::slice::from_ref(&labels[k]),
+                NoiseProtocol::Matched,
+                ctx.split.clone(),
+                Some(opts.snr_db),
+            );
+            let mdir = dir
+                .join("models")
+                .join(format!("{}_{}", kind.name(), ["fl", "fq"][k]));
+            let (mut model, secs) =
+                ctx.fit(&dsc, &sp, kind, &mdir, Some(opts.condition_windows_per_epoch))?;
+            let tr = train_metrics(&mut model, &dsc)?;
+            let te = evaluate(&mut model, &dsc, EvalPart::Test)?;
+            let p = paper::COMPARISON
+                .iter()
+                .find(|(n, _)| *n == kind.name())
+                .map(|(_, v)| {
+                    (
+                        format!("{} / {}", v[4 * k], v[4 * k + 1]),
+                        format!("{} / {}", v[4 * k + 2], v[4 * k + 3]),
+                    )
+                });
+            let (pa, pb) = p.unwrap_or_default();
+            let m = &te.metrics[0];
+            tables[k].push(vec![
+                kind.name().into(),
+                f4(tr[0].mse),
+                f4(tr[0].r2),
+                f4(m.mse),
+                f4(m.r2),
+                f4(m.var_y),
+                format!("{:.2}", m.rmse_kn),
+                format!("{secs:.1}"),
+                pa,
+                pb,
+            ]);
+            if kind.architecture().is_some() {
+                curves[k].push(Series {
+                    label: kind.name().into(),
+                    points: read_log(&mdir)
+                        .iter()
+                        .map(|e| (e.epoch as f64, e.val_loss))
+                        .collect(),
+                });
+            }
+            if kind == ModelKind::CnnBiLstm
+                || (traces[k].is_none() && kind == *opts.models.last().expect("models"))
+            {
+                traces[k] = Some(te.rows.clone());
+            }
+        }
+    }
+    let [fl, fq] = tables;
+    let mut sec = Section {
+        title: format!(
+            "1. Model comparison: {} at {} dB (paper Tables 2–3)",
+            opts.condition, opts.snr_db
+        ),
+        text: vec![
+            format!(
+                "{} models on {}, one model per target as in the paper, every input noised at {} dB, trained and tested on noisy inputs (matched protocol). Train metrics on up to 20 000 training windows; test metrics on every window of the test runs.",
+                opts.models.len(),
+                opts.condition,
+                opts.snr_db
+            ),
+            ctx.protocol(&ctx.split, Some(opts.snr_db)),
+        ],
+        tables: vec![
+            (
+                format!("Lateral force FL ({})", labels[0]),
+                fl,
+                "comparison_fl".into(),
+            ),
+            (
+                format!("Vertical force FQ ({})", labels[1]),
+                fq,
+                "comparison_fq".into(),
+            ),
+        ],
+        figures: Vec::new(),
+    };
+    for (k, name) in [(0, "FL"), (1, "FQ")] {
+        let series = std::mem::take(&mut curves[k]);
+        if !series.is_empty() {
+            sec.figures.push((
+                format!("{name}: validation MSE per epoch"),
+                Chart {
+                    title: format!("Validation loss, {name}"),
+                    x_label: "epoch".into(),
+                    y_label: "MSE (standardised)".into(),
+                    log_x: false,
+                    y_range: None,
+                    series,
+                },
+                format!("training_curves_{}.svg", name.to_lowercase()),
+            ));
+        }
+        if let Some(rows) = &traces[k] {
+            let first = rows.first().map(|r| (r.0.clone(), r.1));
+            let run: Vec<&PredictionRow> = rows
+                .iter()
+                .filter(|r| Some((r.0.clone(), r.1)) == first)
+                .collect();
+            let step = run.len().div_ceil(1500).max(1);
+            let pts: Vec<&PredictionRow> = run.iter().step_by(step).copied().collect();
+            let series = vec![
+                Series {
+                    label: "true".into(),
+                    points: pts.iter().map(|r| (r.2, r.3[0].0 / 1000.0)).collect(),
+                },
+                Series {
+                    label: "identified".into(),
+                    points: pts.iter().map(|r| (r.2, r.3[0].1 / 1000.0)).collect(),
+                },
+            ];
+            let seed = first.map(|f| f.1).unwrap_or(0);
+            sec.figures.push((
+                format!("{name}: identified against true force over the whole test run (seed {seed}, never seen in training)"),
+                Chart {
+                    title: format!("{name}, test run seed {seed}"),
+                    x_label: "time (s)".into(),
+                    y_label: "force (kN)".into(),
+                    log_x: false,
+                    y_range: None,
+                    series,
+                },
+                format!("trace_{}.svg", name.to_lowercase()),
+            ));
+        }
+    }
+    Ok(sec)
+}

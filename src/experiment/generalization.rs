@@ -1,0 +1,173 @@
+//! Experiment 2 (paper Tables 4–5): one CNN-BiLSTM over all conditions, scored per condition
+//! on the test runs; and leave-one-condition-out, the test of transfer to an unseen condition.
+
+use super::{Ctx, f4, paper, per_condition};
+use crate::error::{Error, Result};
+use crate::features::{NoiseProtocol, Split};
+use crate::learn::evaluate::{EvalPart, evaluate};
+use crate::learn::model::ModelKind;
+use crate::report::Section;
+use crate::report::svg::{Chart, Series};
+use crate::report::table::Table;
+
+pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
+    let opts = ctx.opts;
+    let inputs = Ctx::paper21();
+    let labels = ctx.labels();
+    let dsn = ctx.noisy(&ctx.ds, opts.snr_db, &inputs)?;
+    let dir = opts.out.join("generalization");
+    let sp = ctx.spec(
+        &inputs,
+        &labels,
+        NoiseProtocol::Matched,
+        ctx.split.clone(),
+        Some(opts.snr_db),
+    );
+    let (mut model, secs) = ctx.fit(
+        &dsn,
+        &sp,
+        ModelKind::CnnBiLstm,
+        &dir.join("models/all_conditions"),
+        None,
+    )?;
+    let ev = evaluate(&mut model, &dsn, EvalPart::Test)?;
+    let mut t = Table::new(&[
+        "condition",
+        "FL MSE",
+        "FL R²",
+        "FQ MSE",
+        "FQ R²",
+        "Var(FQ_test)",
+        "paper FQ MSE / R²",
+    ]);
+    let (mut fl_pts, mut fq_pts, mut paper_pts) = (Vec::new(), Vec::new(), Vec::new());
+    let mut in_dist = std::collections::HashMap::new();
+    let conditions = ctx.conditions.clone();
+    for (i, c) in conditions.iter().enumerate() {
+        let m = per_condition(&ev.rows, &model, c);
+        let p = paper::generalization(c);
+        t.push(vec![
+            c.clone(),
+            f4(m[0].0),
+            f4(m[0].1),
+            f4(m[1].0),
+            f4(m[1].1),
+            f4(m[1].2),
+            p.map(|(a, b)| format!("{a} / {b}")).unwrap_or("—".into()),
+        ]);
+        fl_pts.push((i as f64 + 1.0, m[0].1));
+        fq_pts.push((i as f64 + 1.0, m[1].1));
+        if let Some((_, r2)) = p {
+            paper_pts.push((i as f64 + 1.0, r2));
+        }
+        in_dist.insert(c.clone(), (m[0].1, m[1].1));
+    }
+    let all = &ev.metrics;
+    ctx.pooled = Some(all.clone());
+    t.push(vec![
+        "all (pooled)".into(),
+        f4(all[0].mse),
+        f4(all[0].r2),
+        f4(all[1].mse),
+        f4(all[1].r2),
+        f4(all[1].var_y),
+        "—".into(),
+    ]);
+    let loco: Vec<String> = if opts.loco.is_empty() {
+        ["curve_r400_v60", "tangent_v80", "grade20_L50_v60"]
+            .iter()
+            .map(|s| s.to_string())
+            .filter(|c| conditions.contains(c))
+            .collect()
+    } else {
+        opts.loco.clone()
+    };
+    let mut lt = Table::new(&[
+        "held-out condition",
+        "validation condition",
+        "FL R² unseen",
+        "FQ R² unseen",
+        "FL R² seen",
+        "FQ R² seen",
+    ]);
+    for c in &loco {
+        let pos = conditions.iter().position(|x| x == c).ok_or_else(|| {
+            Error::Domain(format!("leave-one-out condition {c} is not in the plan"))
+        })?;
+        if conditions.len() < 3 {
+            return Err(Error::Domain(
+                "leave-one-condition-out needs at least three conditions".into(),
+            ));
+        }
+        let val = conditions[(pos + 1) % conditions.len()].clone();
+        let sp = ctx.spec(
+            &inputs,
+            &labels,
+            NoiseProtocol::Matched,
+            Split::Conditions {
+                val: vec![val.clone()],
+                test: vec![c.clone()],
+            },
+            Some(opts.snr_db),
+        );
+        let (mut m, _) = ctx.fit(
+            &dsn,
+            &sp,
+            ModelKind::CnnBiLstm,
+            &dir.join(format!("models/without_{c}")),
+            None,
+        )?;
+        let e = evaluate(&mut m, &dsn, EvalPart::Test)?;
+        let seen = in_dist.get(c).copied().unwrap_or((f64::NAN, f64::NAN));
+        lt.push(vec![
+            c.clone(),
+            val,
+            f4(e.metrics[0].r2),
+            f4(e.metrics[1].r2),
+            f4(seen.0),
+            f4(seen.1),
+        ]);
+    }
+    let series = vec![
+        Series {
+            label: "FL (ours)".into(),
+            points: fl_pts,
+        },
+        Series {
+            label: "FQ (ours)".into(),
+            points: fq_pts,
+        },
+        Series {
+            label: "FQ (paper)".into(),
+            points: paper_pts,
+        },
+    ];
+    Ok(Section {
+        title: "2. Generalisation over conditions (paper Tables 4–5)".into(),
+        text: vec![
+            format!(
+                "One CNN-BiLSTM (FL and FQ as two outputs) trained on all {} conditions at {} dB ({secs:.0} s), scored on each condition's test runs.",
+                conditions.len(),
+                opts.snr_db
+            ),
+            ctx.protocol(&ctx.split, Some(opts.snr_db)),
+            "Leave-one-condition-out (not in the paper): the model is trained without the held-out condition (all its seeds) and without the validation condition used for early stopping, and tested on every run of the held-out condition — transfer to an unseen condition. \"Seen\" is the all-condition model on the same condition's test runs.".into(),
+        ],
+        tables: vec![
+            ("Per-condition test metrics".into(), t, "per_condition".into()),
+            ("Leave one condition out".into(), lt, "leave_one_out".into()),
+        ],
+        figures: vec![(
+            "Test R² per condition (numbered in plan order)".into(),
+            Chart {
+                title: "R² per condition".into(),
+                x_label: "condition (plan order)".into(),
+                y_label: "test R²".into(),
+                log_x: false,
+                y_range: None,
+                series,
+            },
+            "r2_per_condition.svg".into(),
+        )],
+    })
+}

@@ -1,0 +1,134 @@
+//! Beyond the paper: sensor selection (spec learning.md §4.5). The Filter–Wrapper runs over
+//! every on-board candidate signal for FL and for FQ (on the training and validation runs,
+//! noisy at the experiments' SNR); the CNN-BiLSTM on the union of the two selections is
+//! compared with the paper's 21 at each SNR of the experiment.
+
+use super::{Ctx, f4};
+use crate::error::Result;
+use crate::features::{NoiseProtocol, SelectOptions, select};
+use crate::learn::evaluate::{EvalPart, evaluate};
+use crate::learn::model::ModelKind;
+use crate::report::Section;
+use crate::report::table::Table;
+use crate::sensors::{Candidates, clean_name};
+
+pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
+    let opts = ctx.opts;
+    let labels = ctx.labels();
+    let onboard = Candidates::Onboard.among(&ctx.ds.names, &ctx.ds.labels);
+    let dir = opts.out.join("sensors");
+    let dsn = ctx.noisy(&ctx.ds, opts.snr_db, &onboard)?;
+    let mut chosen: Vec<String> = Vec::new();
+    let mut sel_tables = Vec::new();
+    for target in ["FL", "FQ"] {
+        (ctx.log)(format!(
+            "selecting sensors for {target} among {} on-board candidates …",
+            onboard.len()
+        ));
+        let so = SelectOptions {
+            target: target.into(),
+            noisy: true,
+            window: opts.window,
+            label_at: opts.label_at,
+            candidates: Candidates::Onboard,
+            ..SelectOptions::default()
+        };
+        let sel = select(&dsn, &ctx.split, &so)?;
+        let mut t = Table::new(&["channel", "MI nats", "wrapper gain", "kept"]);
+        for r in &sel.table {
+            t.push(vec![
+                clean_name(&r.channel).to_string(),
+                f4(r.mi),
+                r.wrapper_gain
+                    .map(|g| format!("{g:+.4}"))
+                    .unwrap_or_else(|| "filtered".into()),
+                if r.kept { "yes".into() } else { String::new() },
+            ]);
+        }
+        (ctx.log)(format!(
+            "  {target}: kept {} channels: {}",
+            sel.channels.len(),
+            sel.channels
+                .iter()
+                .map(|c| clean_name(c))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        for c in &sel.channels {
+            let c = clean_name(c).to_string();
+            if !chosen.contains(&c) {
+                chosen.push(c);
+            }
+        }
+        sel_tables.push((
+            format!(
+                "Filter–Wrapper for {target} over {} on-board candidates (MI on at most {} training rows, ridge on at most {} training windows)",
+                onboard.len(),
+                so.mi_samples,
+                so.max_windows
+            ),
+            t,
+            format!("selection_{}", target.to_lowercase()),
+        ));
+    }
+    let mut t = Table::new(&[
+        "inputs",
+        "channels",
+        "SNR dB",
+        "FL R²",
+        "FQ R²",
+        "FL RMSE kN",
+        "FQ RMSE kN",
+    ]);
+    let paper = Ctx::paper21();
+    for &snr in &opts.sensor_snrs {
+        let dsn = ctx.noisy(&ctx.ds, snr, &onboard)?;
+        for (name, inputs) in [("paper's 21", &paper), ("selected on-board", &chosen)] {
+            let sp = ctx.spec(
+                inputs,
+                &labels,
+                NoiseProtocol::Matched,
+                ctx.split.clone(),
+                Some(snr),
+            );
+            let tag = if inputs == &paper { "paper21" } else { "selected" };
+            let e = match &ctx.pooled {
+                Some(m) if tag == "paper21" && snr == opts.snr_db => m.clone(),
+                _ => {
+                    let mdir = dir.join(format!("models/{tag}_{snr}dB"));
+                    let (mut m, _) = ctx.fit(&dsn, &sp, ModelKind::CnnBiLstm, &mdir, None)?;
+                    evaluate(&mut m, &dsn, EvalPart::Test)?.metrics
+                }
+            };
+            t.push(vec![
+                name.into(),
+                inputs.len().to_string(),
+                format!("{snr}"),
+                f4(e[0].r2),
+                f4(e[1].r2),
+                format!("{:.2}", e[0].rmse_kn),
+                format!("{:.2}", e[1].rmse_kn),
+            ]);
+        }
+    }
+    let mut tables = vec![(
+        "CNN-BiLSTM (FL and FQ as two outputs), pooled test metrics".into(),
+        t,
+        "sensors".into(),
+    )];
+    tables.extend(sel_tables);
+    Ok(Section {
+        title: "5. On-board sensor selection (not in the paper)".into(),
+        text: vec![
+            format!(
+                "Candidates: every on-board measurable signal railforce records ({}): body accelerations, angular rates, track-relative displacements and angles, and the deflections of the spring nests, shear pads, side bearers and centre plates; wheel forces, contact quantities and other wheels' creepages are not candidates. Selected union for FL and FQ ({} channels): {}.",
+                onboard.len(),
+                chosen.len(),
+                chosen.join(", ")
+            ),
+            ctx.protocol(&ctx.split, Some(opts.snr_db)),
+        ],
+        tables,
+        figures: Vec::new(),
+    })
+}

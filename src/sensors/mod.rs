@@ -1,0 +1,14 @@
+//! The sensor contract: what passes from the simulator to the learner. Channel names, units
+//! and kinds ([`channels`]), the paper's 21 inputs, the label wheel's force channels, the
+//! on-board candidate signals the Filter–Wrapper may choose from, the `_noisy` naming, and the
+//! one noise model ([`noise`]) that `generate`, training's fresh noise, the experiments and
+//! `validate identify` all use (spec learning.md §1.4, §2; physics.md §5).
+
+pub mod channels;
+pub mod noise;
+
+pub use channels::{
+    Candidates, ChannelKind, PAPER_CHANNELS, PAPER_UNITS, clean_name, is_noisy, label_channels,
+    noisy_name,
+};
+pub use noise::{NoiseModel, SnrReference};
