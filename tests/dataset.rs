@@ -1,8 +1,8 @@
 //! Data set generation: formats, resume, shards, noise, and loading from Python.
 
-use railforce::sensors::{NoiseModel, SnrReference};
 use railforce::dataset::{self, Event, Format, GenerateOptions, npz};
 use railforce::plan::Plan;
+use railforce::sensors::{NoiseModel, SnrReference};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 

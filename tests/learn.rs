@@ -1,6 +1,5 @@
 //! Trainer, model directories and classical regressors on small synthetic problems.
 
-use railforce::sensors::{NoiseModel, SnrReference};
 use railforce::features::{DataSet, LabelAt, NoiseProtocol, Run, Split};
 use railforce::learn::classical::{Classical, ClassicalParams};
 use railforce::learn::evaluate::{EvalPart, evaluate};
@@ -8,6 +7,7 @@ use railforce::learn::metrics::metrics;
 use railforce::learn::model::{Model, ModelKind};
 use railforce::learn::train::{TrainOptions, train};
 use railforce::learn::windows::DataSpec;
+use railforce::sensors::{NoiseModel, SnrReference};
 use std::path::PathBuf;
 
 fn tmp(name: &str) -> PathBuf {

@@ -51,15 +51,27 @@ fn deflection_channels_exist_and_read_zero_in_the_static_loaded_position() {
         .filter(|&i| ChannelKind::of(&names[i], &labels) == ChannelKind::Deflection)
         .collect();
     // 4 nests × 2 + 8 pads × 3 + 4 side bearers + 2 centre plates.
-    assert_eq!(defl.len(), 38, "{:?}", defl.iter().map(|&i| &names[i]).collect::<Vec<_>>());
+    assert_eq!(
+        defl.len(),
+        38,
+        "{:?}",
+        defl.iter().map(|&i| &names[i]).collect::<Vec<_>>()
+    );
     for n in DEFLECTIONS {
-        let i = names.iter().position(|c| c == n).unwrap_or_else(|| panic!("no {n}"));
+        let i = names
+            .iter()
+            .position(|c| c == n)
+            .unwrap_or_else(|| panic!("no {n}"));
         assert!(row[i].is_finite());
         assert!(row[i].abs() < 1e-9, "{n} reads {} m at rest", row[i]);
     }
     let cands = Candidates::Onboard.among(&names, &labels);
     assert!(cands.len() > 100, "{}", cands.len());
-    assert!(cands.iter().all(|c| !c.contains("force") && !c.contains("_xi_")));
+    assert!(
+        cands
+            .iter()
+            .all(|c| !c.contains("force") && !c.contains("_xi_"))
+    );
 }
 
 #[test]
@@ -94,7 +106,10 @@ fn the_label_wheel_of_the_vehicle_file_reaches_the_labels() {
     assert_eq!(ds.target_channel("FQ"), "w2r_force_z");
     assert_eq!(ds.noise, Some(NoiseModel::new(6.0, SnrReference::Std)));
     // The paper's creepage inputs are those of the label wheel.
-    let (a, b) = (ds.channel("w1l_creep_y").unwrap(), ds.channel("w2r_xi_y").unwrap());
+    let (a, b) = (
+        ds.channel("w1l_creep_y").unwrap(),
+        ds.channel("w2r_xi_y").unwrap(),
+    );
     assert_eq!(ds.runs[0].columns[a], ds.runs[0].columns[b]);
     // Three seeds: the standard split tests on the last, validates on the one before.
     assert_eq!(
@@ -196,6 +211,10 @@ fn outer_spring_nests_compress_more_with_cant_deficiency() {
         );
     }
     for c in 0..rec.names.len() {
-        assert!(rec.rows.iter().all(|r| r[c].is_finite()), "{}", rec.names[c]);
+        assert!(
+            rec.rows.iter().all(|r| r[c].is_finite()),
+            "{}",
+            rec.names[c]
+        );
     }
 }

@@ -15,8 +15,7 @@ fn data(n: usize, rng: &mut ChaCha8Rng) -> (Vec<f32>, Vec<f32>) {
     let mut y = Vec::with_capacity(n);
     for _ in 0..n {
         let row: Vec<f32> = (0..f).map(|_| rng.random_range(-2.0f32..2.0)).collect();
-        let t = (1.5 * row[0]).sin() + 0.4 * row[1] * row[2] + 0.3 * row[3]
-            - 0.2 * row[4].powi(2)
+        let t = (1.5 * row[0]).sin() + 0.4 * row[1] * row[2] + 0.3 * row[3] - 0.2 * row[4].powi(2)
             + 0.5
             + 0.1 * rng.random_range(-1.0f32..1.0);
         x.extend_from_slice(&row);
@@ -42,7 +41,11 @@ fn write_csv(path: &std::path::Path, v: &[f32], cols: usize) {
 fn r2(y: &[f32], p: &[f32]) -> f64 {
     let m = y.iter().map(|&v| v as f64).sum::<f64>() / y.len() as f64;
     let sst: f64 = y.iter().map(|&v| (v as f64 - m).powi(2)).sum();
-    let sse: f64 = y.iter().zip(p).map(|(&a, &b)| (a as f64 - b as f64).powi(2)).sum();
+    let sse: f64 = y
+        .iter()
+        .zip(p)
+        .map(|(&a, &b)| (a as f64 - b as f64).powi(2))
+        .sum();
     1.0 - sse / sst
 }
 
@@ -69,9 +72,20 @@ fn classical_models_match_scikit_learn() {
     write_csv(&dir.join("train_y.csv"), &ytr, 1);
     write_csv(&dir.join("test_x.csv"), &xte, 20);
     write_csv(&dir.join("test_y.csv"), &yte, 1);
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/analysis/sklearn_check.py");
-    let out = Command::new("python3").arg(script).arg(&dir).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/assets/analysis/sklearn_check.py"
+    );
+    let out = Command::new("python3")
+        .arg(script)
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let sk: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let mut failures = Vec::new();
     for (name, params) in [
@@ -84,7 +98,9 @@ fn classical_models_match_scikit_learn() {
         let theirs = sk[name].as_f64().unwrap();
         eprintln!("{name}: railforce R² {ours:.4}, scikit-learn {theirs:.4}");
         if (ours - theirs).abs() >= 0.03 {
-            failures.push(format!("{name}: railforce R² {ours:.4} vs scikit-learn {theirs:.4}"));
+            failures.push(format!(
+                "{name}: railforce R² {ours:.4} vs scikit-learn {theirs:.4}"
+            ));
         }
     }
     assert!(failures.is_empty(), "{failures:?}");

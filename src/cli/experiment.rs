@@ -4,8 +4,8 @@
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use railforce::experiment::{self, ExperimentOptions, Which};
-use railforce::learn::model::ModelKind;
 use railforce::features::Split;
+use railforce::learn::model::ModelKind;
 use railforce::learn::train::TrainOptions;
 use railforce::sensors::SnrReference;
 use std::path::PathBuf;

@@ -46,8 +46,13 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             let mdir = dir
                 .join("models")
                 .join(format!("{}_{}", kind.name(), ["fl", "fq"][k]));
-            let (mut model, secs) =
-                ctx.fit(&dsc, &sp, kind, &mdir, Some(opts.condition_windows_per_epoch))?;
+            let (mut model, secs) = ctx.fit(
+                &dsc,
+                &sp,
+                kind,
+                &mdir,
+                Some(opts.condition_windows_per_epoch),
+            )?;
             let tr = train_metrics(&mut model, &dsc)?;
             let te = evaluate(&mut model, &dsc, EvalPart::Test)?;
             let p = paper::COMPARISON

@@ -99,7 +99,11 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             ),
             ctx.protocol(&ctx.split, Some(opts.snr_db)),
         ],
-        tables: vec![("CNN-BiLSTM test metrics per protocol".into(), t, "protocols".into())],
+        tables: vec![(
+            "CNN-BiLSTM test metrics per protocol".into(),
+            t,
+            "protocols".into(),
+        )],
         figures: Vec::new(),
     })
 }

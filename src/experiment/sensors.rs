@@ -91,7 +91,11 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 ctx.split.clone(),
                 Some(snr),
             );
-            let tag = if inputs == &paper { "paper21" } else { "selected" };
+            let tag = if inputs == &paper {
+                "paper21"
+            } else {
+                "selected"
+            };
             let e = match &ctx.pooled {
                 Some(m) if tag == "paper21" && snr == opts.snr_db => m.clone(),
                 _ => {

@@ -110,7 +110,11 @@ impl DataSet {
     }
 
     /// The runs whose condition is in `conditions`, and only the columns `channels`.
-    pub fn subset(&self, conditions: Option<&[String]>, channels: Option<&[String]>) -> Result<DataSet> {
+    pub fn subset(
+        &self,
+        conditions: Option<&[String]>,
+        channels: Option<&[String]>,
+    ) -> Result<DataSet> {
         let idx: Vec<usize> = match channels {
             Some(c) => c.iter().map(|n| self.channel(n)).collect::<Result<_>>()?,
             None => (0..self.names.len()).collect(),
@@ -385,7 +389,12 @@ impl Split {
 
     /// One line for tables and reports.
     pub fn describe(&self) -> String {
-        let list = |v: &[u64]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ");
+        let list = |v: &[u64]| {
+            v.iter()
+                .map(|s| s.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         match self {
             Split::Seeds { train, val, test } => format!(
                 "by seed: train on seeds {}, validate on {}, test on whole runs of seed {} (independent track irregularities)",

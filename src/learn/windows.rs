@@ -254,9 +254,7 @@ impl NoiseRefresher {
             .map(|r| {
                 cols.iter()
                     .enumerate()
-                    .map(|(k, &c)| {
-                        (model.sigma(&r.columns[c]) / stats.std[k]) as f32
-                    })
+                    .map(|(k, &c)| (model.sigma(&r.columns[c]) / stats.std[k]) as f32)
                     .collect()
             })
             .collect();

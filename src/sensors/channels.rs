@@ -178,7 +178,9 @@ impl Candidates {
                 ChannelKind::Deflection => self == Candidates::Onboard,
                 ChannelKind::Body => {
                     self == Candidates::Onboard
-                        && BODY_MEASURABLE.iter().any(|s| n.ends_with(&format!("_{s}")))
+                        && BODY_MEASURABLE
+                            .iter()
+                            .any(|s| n.ends_with(&format!("_{s}")))
                 }
                 _ => false,
             })
@@ -208,10 +210,18 @@ mod tests {
         );
         assert_eq!(ChannelKind::of("carbody_acc_y", &labels), ChannelKind::Body);
         assert_eq!(clean_name(&noisy_name("x")), "x");
-        let names: Vec<String> = ["time_s", "ws1_acc_y", "w1l_force_y", "w1l_xi_x", "carbody_roll", "nest_sideframe1l_z", "carbody_acc_y_noisy"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let names: Vec<String> = [
+            "time_s",
+            "ws1_acc_y",
+            "w1l_force_y",
+            "w1l_xi_x",
+            "carbody_roll",
+            "nest_sideframe1l_z",
+            "carbody_acc_y_noisy",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
         let l = label_channels("1L");
         assert_eq!(Candidates::Paper21.among(&names, &l), ["ws1_acc_y"]);
         assert_eq!(

@@ -293,7 +293,11 @@ impl Vehicle {
     /// the paper's, for a vehicle without one).
     pub fn label_wheel_name(&self) -> String {
         let k = self.sensors.as_ref().map_or(0, |s| s.label_wheel);
-        format!("{}{}", k / 2 + 1, if k % 2 == 0 { 'L' } else { 'R' })
+        format!(
+            "{}{}",
+            k / 2 + 1,
+            if k.is_multiple_of(2) { 'L' } else { 'R' }
+        )
     }
 
     /// Total mass, kg.
