@@ -12,7 +12,7 @@ fn tiny_plan(dir: &Path) -> PathBuf {
         r#"name = "tiny"
 vehicle = "{v}"
 duration_s = 4.0
-seeds = [1]
+seeds = [1, 2, 3]
 
 [[condition]]
 name = "tangent_v80"

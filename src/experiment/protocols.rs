@@ -16,16 +16,17 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let labels = ctx.labels();
     let dsn = ctx.noisy(&ctx.ds, opts.snr_db, &inputs)?;
     let dir = opts.out.join("protocols");
-    let held: Vec<String> = ["curve_r400_v60", "tangent_v80", "grade20_L50_v60"]
+    // Held out: a curve, a tangent and a gradient case where the plan has them, leaving at
+    // least one condition to validate and one to train on.
+    let mut held: Vec<String> = ["curve_r400_v60", "tangent_v80", "grade20_L50_v60"]
         .iter()
         .map(|s| s.to_string())
         .filter(|c| ctx.conditions.contains(c))
         .collect();
-    let held = if held.is_empty() {
-        vec![ctx.conditions[0].clone()]
-    } else {
-        held
-    };
+    held.truncate(ctx.conditions.len().saturating_sub(2).max(1));
+    if held.is_empty() {
+        held.push(ctx.conditions[0].clone());
+    }
     let val: Vec<String> = ctx
         .conditions
         .iter()
