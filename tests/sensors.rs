@@ -218,3 +218,74 @@ fn outer_spring_nests_compress_more_with_cant_deficiency() {
         );
     }
 }
+
+/// A model trained at 6 dB records its noise, and the closed loop tests it on inputs noised
+/// the same way (not on clean ones).
+#[test]
+fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
+    use railforce::features::NoiseProtocol;
+    use railforce::identify::closed_loop;
+    use railforce::identify::safety::Limits;
+    use railforce::learn::model::ModelKind;
+    use railforce::learn::train::{TrainOptions, train};
+    use railforce::learn::windows::DataSpec;
+    let dir = temp("closed");
+    let plan_text = format!(
+        "name = \"closed\"\nvehicle = \"{}\"\nduration_s = 0.6\nseeds = [1, 2, 3]\n\
+         [[condition]]\nname = \"tangent\"\ntrack = \"{}\"\nspeed_kmh = 60.0\n",
+        root().join("vehicles/c80.toml").display(),
+        root().join("tracks/tangent.toml").display()
+    );
+    std::fs::write(dir.join("p.plan.toml"), plan_text).unwrap();
+    let plan = Plan::load(&dir.join("p.plan.toml")).unwrap();
+    let noise = NoiseModel::new(6.0, SnrReference::Std);
+    let opts = GenerateOptions {
+        out: dir.join("data"),
+        format: Format::Npz,
+        jobs: 2,
+        shard: None,
+        noise: Some(noise),
+        settle: 0.1,
+    };
+    dataset::generate(&plan, &opts, &|_| {}).unwrap();
+    let ds = DataSet::load(&dir.join("data")).unwrap();
+    let spec = DataSpec {
+        channels: railforce::sensors::PAPER_CHANNELS
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+        targets: ds.labels.to_vec(),
+        window: 20,
+        label_at: LabelAt::Last,
+        stride: 1,
+        split: Split::standard(&ds),
+        noise: NoiseProtocol::Matched,
+        noise_model: None,
+    };
+    let mut model = train(
+        &ds,
+        &spec,
+        ModelKind::Tree,
+        &TrainOptions::default(),
+        &dir.join("model"),
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(
+        model.meta.data.noise_model,
+        Some(noise),
+        "the model records its SNR"
+    );
+    let work = dir.join("closed_loop");
+    let checks =
+        closed_loop::validate(&mut model, &plan, 1001, &work, 1, &Limits::default()).unwrap();
+    assert_eq!(checks.len(), 1);
+    assert!(checks[0].targets.iter().all(|t| t.rmse_kn.is_finite()));
+    let fresh = DataSet::load(&work).unwrap();
+    assert_eq!(
+        fresh.noise,
+        Some(noise),
+        "fresh runs noised at the model's SNR"
+    );
+    assert!(fresh.channel("ws1_acc_z_noisy").is_ok());
+}

@@ -22,7 +22,8 @@ pub struct DataArgs {
     /// all 21 paper channels, window 20, label at the last step.
     #[arg(long)]
     pub selection: Option<PathBuf>,
-    /// Target: FL (lateral force, wheel 1 left), FQ (vertical), both, or a label channel name.
+    /// Target: FL (lateral force of the vehicle's label wheel, 1L for the C80), FQ (vertical),
+    /// both, or a label channel name.
     #[arg(long, default_value = "both")]
     pub target: String,
     /// Noise protocol: clean, train-clean-test-noisy, or matched (train and test on the
@@ -338,7 +339,27 @@ pub struct EvaluateArgs {
 
 pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
     let mut model = Model::load(&args.model)?;
-    let ds = DataSet::load(&args.data)?;
+    let mut ds = DataSet::load(&args.data)?;
+    // A model that reads noisy inputs, on a clean data set: noise it as the model was noised
+    // (its recorded SNR and reference), seeded per run and channel as `generate` does.
+    let reads_noisy = model.meta.data.noise != NoiseProtocol::Clean;
+    let has_noisy = model
+        .meta
+        .data
+        .channels
+        .iter()
+        .all(|c| ds.channel(&railforce::sensors::noisy_name(c)).is_ok());
+    if reads_noisy
+        && !has_noisy
+        && let Some(noise) = model.meta.data.noise_model
+    {
+        eprintln!(
+            "note: {} has no noisy inputs; adding them as the model was trained: {}",
+            args.data.display(),
+            noise.describe()
+        );
+        ds = ds.with_noise(noise, &model.meta.data.channels)?;
+    }
     let part = if args.all {
         EvalPart::All
     } else {
@@ -350,9 +371,9 @@ pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
         model.meta.kind.name(),
         args.data.display(),
         if args.all {
-            "all windows"
+            "all windows".to_string()
         } else {
-            "test blocks"
+            format!("test part: {}", model.meta.data.split.describe())
         },
         model.meta.data.noise,
         ev.metrics.first().map(|m| m.n).unwrap_or(0),
