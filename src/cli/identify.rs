@@ -216,11 +216,18 @@ pub fn validate(
     let plan = railforce::plan::Plan::load(plan)?;
     let seed = seed.unwrap_or_else(|| railforce::identify::closed_loop::fresh_seed(&model));
     let work = model_dir.join(format!("closed_loop_seed{seed}"));
+    let noise = match model.meta.data.noise {
+        railforce::features::NoiseProtocol::Clean => None,
+        _ => model.meta.data.noise_model,
+    };
     eprintln!(
-        "simulating {} condition(s) of {} with seed {seed} into {} …",
+        "simulating {} condition(s) of {} with seed {seed} into {}, inputs {} (as the model was trained) …",
         plan.conditions.len(),
         plan.name,
-        work.display()
+        work.display(),
+        noise
+            .map(|n| format!("noised at {} dB, σ from the {}", n.snr_db, n.reference.name()))
+            .unwrap_or_else(|| "clean".into())
     );
     let runs =
         railforce::identify::closed_loop::validate(&mut model, &plan, seed, &work, jobs, limits)?;
