@@ -226,7 +226,11 @@ pub fn validate(
         plan.name,
         work.display(),
         noise
-            .map(|n| format!("noised at {} dB, σ from the {}", n.snr_db, n.reference.name()))
+            .map(|n| format!(
+                "noised at {} dB, σ from the {}",
+                n.snr_db,
+                n.reference.name()
+            ))
             .unwrap_or_else(|| "clean".into())
     );
     let runs =
