@@ -1,7 +1,7 @@
 //! ε-support-vector regression with an RBF kernel `k(a, b) = exp(−γ‖a − b‖²)`, exact on a
 //! subsample of the training windows (the kernel matrix is n², so the full 285 k windows would
 //! not fit). Solved in the dual by coordinate descent (Ho & Lin 2012, the LIBLINEAR ε-SVR
-//! solver, here with a precomputed kernel): minimise `½βᵀ(K + 1)βᵀ − tᵀβ + ε‖β‖₁` subject to
+//! solver, here with a precomputed kernel): minimise `½βᵀ(K + 1)β − tᵀβ + ε‖β‖₁` subject to
 //! `|β_i| ≤ C`, with `t` the targets less their mean. The `+ 1` is the bias feature of
 //! LIBLINEAR (B = 1): it fits the intercept `b = Σβ_i` beside the mean offset. Sweeps run
 //! until no coordinate moves the objective's gradient by more than the tolerance (scikit-
