@@ -70,7 +70,7 @@ impl Svr {
         // Coordinates in a new random order every sweep (as LIBLINEAR): a fixed order
         // converges far more slowly on the strongly correlated windows of a run.
         let mut order: Vec<usize> = (0..n).collect();
-        let mut rng = crate::sensors::noise::rng(n as u64, 0x5356_52);
+        let mut rng = crate::sensors::noise::rng(n as u64, 0x0053_5652);
         for sweep in 0..p.max_sweeps {
             sweeps = sweep + 1;
             let mut max_step = 0.0f64;
