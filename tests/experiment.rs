@@ -56,7 +56,7 @@ fn every_experiment_runs_end_to_end() {
         },
         ..ExperimentOptions::full(tiny_plan(&dir), dir.join("out"))
     };
-    let index = run(&[Which::All], &opts, &mut |_| {}).unwrap();
+    let index = run(&[Which::All], &opts, &|_| {}).unwrap();
     let out = dir.join("out");
     let header = |p: &str| {
         std::fs::read_to_string(out.join(p))

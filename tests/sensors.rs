@@ -289,3 +289,21 @@ fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
     );
     assert!(fresh.channel("ws1_acc_z_noisy").is_ok());
 }
+
+/// One signal under two names is one candidate: the second name is dropped.
+#[test]
+fn a_signal_recorded_twice_is_one_candidate() {
+    let a: Vec<f64> = (0..50).map(|i| (i as f64).sin()).collect();
+    let c: Vec<f64> = (0..50).map(|i| (i as f64).cos()).collect();
+    let run = railforce::features::Run {
+        condition: "c".into(),
+        seed: 1,
+        columns: vec![a.clone(), a, c],
+    };
+    let names: Vec<String> = ["ws1_acc_y", "wheelset1_acc_y", "carbody_acc_y"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let ds = DataSet::in_memory(&PathBuf::from("mem"), names.clone(), vec![run]);
+    assert_eq!(ds.distinct_channels(&names), ["ws1_acc_y", "carbody_acc_y"]);
+}

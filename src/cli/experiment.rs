@@ -71,7 +71,8 @@ pub struct ExperimentArgs {
     /// Seed of every training.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Simulations in parallel.
+    /// Simulations, and trainings, in parallel (each training runs on one thread; the models
+    /// do not depend on how many run at once).
     #[arg(long, default_value_t = 2)]
     jobs: usize,
     /// Label at the last step of the window (causal, usable on board in real time) instead of
@@ -91,7 +92,7 @@ pub struct ExperimentArgs {
 
 fn run_with(which: &[Which], opts: &ExperimentOptions) -> Result<()> {
     let t0 = std::time::Instant::now();
-    let index = experiment::run(which, opts, &mut |line| {
+    let index = experiment::run(which, opts, &|line| {
         eprintln!("[{:>6.0} s] {line}", t0.elapsed().as_secs_f64())
     })?;
     println!(

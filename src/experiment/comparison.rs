@@ -2,7 +2,7 @@
 //! the paper trains them, train and test MSE / R², training curves and identified-against-true
 //! traces of a whole test run.
 
-use super::{Ctx, f4, paper, read_log, train_metrics};
+use super::{Ctx, FitJob, f4, paper, read_log, train_metrics};
 use crate::error::Result;
 use crate::features::NoiseProtocol;
 use crate::learn::evaluate::{EvalPart, PredictionRow, evaluate};
@@ -34,25 +34,35 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let mut curves: [Vec<Series>; 2] = [Vec::new(), Vec::new()];
     let mut traces: [Option<Vec<PredictionRow>>; 2] = [None, None];
     let labels = ctx.labels();
+    let mut jobs = Vec::new();
     for &kind in &opts.models {
         for k in 0..2 {
-            let sp = ctx.spec(
-                &inputs,
-                std::slice::from_ref(&labels[k]),
-                NoiseProtocol::Matched,
-                ctx.split.clone(),
-                Some(opts.snr_db),
-            );
-            let mdir = dir
-                .join("models")
-                .join(format!("{}_{}", kind.name(), ["fl", "fq"][k]));
-            let (mut model, secs) = ctx.fit(
-                &dsc,
-                &sp,
+            jobs.push(FitJob {
+                ds: &dsc,
+                spec: ctx.spec(
+                    &inputs,
+                    std::slice::from_ref(&labels[k]),
+                    NoiseProtocol::Matched,
+                    ctx.split.clone(),
+                    Some(opts.snr_db),
+                ),
                 kind,
-                &mdir,
-                Some(opts.condition_windows_per_epoch),
-            )?;
+                dir: dir
+                    .join("models")
+                    .join(format!("{}_{}", kind.name(), ["fl", "fq"][k])),
+                windows: Some(opts.condition_windows_per_epoch),
+            });
+        }
+    }
+    let fitted = ctx.fit_all(&jobs)?;
+    for (job, (mut model, secs)) in jobs.iter().zip(fitted) {
+        let (kind, mdir) = (job.kind, &job.dir);
+        let k = if job.spec.targets[0] == labels[0] {
+            0
+        } else {
+            1
+        };
+        {
             let tr = train_metrics(&mut model, &dsc)?;
             let te = evaluate(&mut model, &dsc, EvalPart::Test)?;
             let p = paper::COMPARISON
@@ -81,7 +91,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             if kind.architecture().is_some() {
                 curves[k].push(Series {
                     label: kind.name().into(),
-                    points: read_log(&mdir)
+                    points: read_log(mdir)
                         .iter()
                         .map(|e| (e.epoch as f64, e.val_loss))
                         .collect(),

@@ -1,7 +1,7 @@
 //! Experiment 2 (paper Tables 4–5): one CNN-BiLSTM over all conditions, scored per condition
 //! on the test runs; and leave-one-condition-out, the test of transfer to an unseen condition.
 
-use super::{Ctx, f4, paper, per_condition};
+use super::{Ctx, FitJob, f4, paper, per_condition};
 use crate::error::{Error, Result};
 use crate::features::{NoiseProtocol, Split};
 use crate::learn::evaluate::{EvalPart, evaluate};
@@ -23,13 +23,54 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         ctx.split.clone(),
         Some(opts.snr_db),
     );
-    let (mut model, secs) = ctx.fit(
-        &dsn,
-        &sp,
-        ModelKind::CnnBiLstm,
-        &dir.join("models/all_conditions"),
-        None,
-    )?;
+    let conditions = ctx.conditions.clone();
+    let loco: Vec<String> = if opts.loco.is_empty() {
+        ["curve_r400_v60", "tangent_v80", "grade20_L50_v60"]
+            .iter()
+            .map(|s| s.to_string())
+            .filter(|c| conditions.contains(c))
+            .collect()
+    } else {
+        opts.loco.clone()
+    };
+    if !loco.is_empty() && conditions.len() < 3 {
+        return Err(Error::Domain(
+            "leave-one-condition-out needs at least three conditions".into(),
+        ));
+    }
+    let mut jobs = vec![FitJob {
+        ds: &dsn,
+        spec: sp,
+        kind: ModelKind::CnnBiLstm,
+        dir: dir.join("models/all_conditions"),
+        windows: None,
+    }];
+    let mut vals = Vec::new();
+    for c in &loco {
+        let pos = conditions.iter().position(|x| x == c).ok_or_else(|| {
+            Error::Domain(format!("leave-one-out condition {c} is not in the plan"))
+        })?;
+        let val = conditions[(pos + 1) % conditions.len()].clone();
+        jobs.push(FitJob {
+            ds: &dsn,
+            spec: ctx.spec(
+                &inputs,
+                &labels,
+                NoiseProtocol::Matched,
+                Split::Conditions {
+                    val: vec![val.clone()],
+                    test: vec![c.clone()],
+                },
+                Some(opts.snr_db),
+            ),
+            kind: ModelKind::CnnBiLstm,
+            dir: dir.join(format!("models/without_{c}")),
+            windows: None,
+        });
+        vals.push(val);
+    }
+    let mut fitted = ctx.fit_all(&jobs)?.into_iter();
+    let (mut model, secs) = fitted.next().expect("the all-condition model");
     let ev = evaluate(&mut model, &dsn, EvalPart::Test)?;
     let mut t = Table::new(&[
         "condition",
@@ -42,7 +83,6 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     ]);
     let (mut fl_pts, mut fq_pts, mut paper_pts) = (Vec::new(), Vec::new(), Vec::new());
     let mut in_dist = std::collections::HashMap::new();
-    let conditions = ctx.conditions.clone();
     for (i, c) in conditions.iter().enumerate() {
         let m = per_condition(&ev.rows, &model, c);
         let p = paper::generalization(c);
@@ -73,15 +113,6 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         f4(all[1].var_y),
         "—".into(),
     ]);
-    let loco: Vec<String> = if opts.loco.is_empty() {
-        ["curve_r400_v60", "tangent_v80", "grade20_L50_v60"]
-            .iter()
-            .map(|s| s.to_string())
-            .filter(|c| conditions.contains(c))
-            .collect()
-    } else {
-        opts.loco.clone()
-    };
     let mut lt = Table::new(&[
         "held-out condition",
         "validation condition",
@@ -90,33 +121,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         "FL R² seen",
         "FQ R² seen",
     ]);
-    for c in &loco {
-        let pos = conditions.iter().position(|x| x == c).ok_or_else(|| {
-            Error::Domain(format!("leave-one-out condition {c} is not in the plan"))
-        })?;
-        if conditions.len() < 3 {
-            return Err(Error::Domain(
-                "leave-one-condition-out needs at least three conditions".into(),
-            ));
-        }
-        let val = conditions[(pos + 1) % conditions.len()].clone();
-        let sp = ctx.spec(
-            &inputs,
-            &labels,
-            NoiseProtocol::Matched,
-            Split::Conditions {
-                val: vec![val.clone()],
-                test: vec![c.clone()],
-            },
-            Some(opts.snr_db),
-        );
-        let (mut m, _) = ctx.fit(
-            &dsn,
-            &sp,
-            ModelKind::CnnBiLstm,
-            &dir.join(format!("models/without_{c}")),
-            None,
-        )?;
+    for ((c, val), (mut m, _)) in loco.iter().zip(vals).zip(fitted) {
         let e = evaluate(&mut m, &dsn, EvalPart::Test)?;
         let seen = in_dist.get(c).copied().unwrap_or((f64::NAN, f64::NAN));
         lt.push(vec![

@@ -98,7 +98,7 @@ pub struct ExperimentOptions {
     pub train: TrainOptions,
     /// Training windows per epoch of the one-condition models (comparison, robustness).
     pub condition_windows_per_epoch: usize,
-    /// Simulations in parallel.
+    /// Simulations, and trainings, in parallel (each training uses one thread).
     pub jobs: usize,
     /// Label position (the centre: as the paper reads, the default; the last: causal).
     pub label_at: LabelAt,
@@ -162,7 +162,7 @@ impl ExperimentOptions {
 /// Shared state of a run of experiments.
 struct Ctx<'a> {
     opts: &'a ExperimentOptions,
-    log: &'a mut dyn FnMut(String),
+    log: &'a (dyn Fn(String) + Sync),
     /// All conditions, clean, with the paper's inputs, the labels and time.
     ds: DataSet,
     /// The split every experiment uses unless it studies splits.
@@ -215,7 +215,7 @@ impl Ctx<'_> {
     /// Trains `kind`; with the matched protocol, networks draw fresh training noise every
     /// epoch when the options say so ([`ExperimentOptions::fresh_noise`]).
     fn fit(
-        &mut self,
+        &self,
         ds: &DataSet,
         spec: &DataSpec,
         kind: ModelKind,
@@ -223,9 +223,12 @@ impl Ctx<'_> {
         windows_per_epoch: Option<usize>,
     ) -> Result<(Model, f64)> {
         let t0 = Instant::now();
-        let name = format!("{} → {}", kind.name(), dir.display());
-        (self.log)(format!("training {name}"));
-        let log = &mut self.log;
+        let name = dir
+            .strip_prefix(&self.opts.out)
+            .unwrap_or(dir)
+            .display()
+            .to_string();
+        (self.log)(format!("training {} → {name}", kind.name()));
         let opts = TrainOptions {
             fresh_noise: spec
                 .noise_model
@@ -237,15 +240,54 @@ impl Ctx<'_> {
             if let Progress::Epoch(e) = p
                 && (e.epoch % 10 == 0 || e.epoch == 1)
             {
-                log(format!(
-                    "  epoch {:>3}: val {:.4}, best epoch {}, {:.0} windows/s",
+                (self.log)(format!(
+                    "  {name}: epoch {:>3}: val {:.4}, best epoch {}, {:.0} windows/s",
                     e.epoch, e.val_loss, e.best_epoch, e.windows_per_s
                 ));
             }
         })?;
         let secs = t0.elapsed().as_secs_f64();
-        (self.log)(format!("  done in {secs:.1} s"));
+        (self.log)(format!("  {name}: done in {secs:.1} s"));
         Ok((model, secs))
+    }
+
+    /// Trains every job, [`ExperimentOptions::jobs`] at a time (each training runs on one
+    /// thread and is seeded on its own, so the models do not depend on the order), and
+    /// returns the models in the order of the jobs.
+    fn fit_all(&self, jobs: &[FitJob]) -> Result<Vec<(Model, f64)>> {
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let done: std::sync::Mutex<Vec<Option<Fitted>>> =
+            std::sync::Mutex::new((0..jobs.len()).map(|_| None).collect());
+        std::thread::scope(|scope| {
+            for _ in 0..self.opts.jobs.max(1).min(jobs.len()) {
+                scope.spawn(|| {
+                    loop {
+                        let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                        let Some(j) = jobs.get(k) else { return };
+                        let r = self.fit(j.ds, &j.spec, j.kind, &j.dir, j.windows);
+                        let failed = r.is_err();
+                        done.lock().expect("results lock")[k] = Some(r);
+                        if failed {
+                            // Stop handing out work: the first error ends the experiment.
+                            next.store(jobs.len(), std::sync::atomic::Ordering::SeqCst);
+                            return;
+                        }
+                    }
+                });
+            }
+        });
+        let mut out = Vec::with_capacity(jobs.len());
+        for r in done.into_inner().expect("results lock") {
+            match r {
+                Some(r) => out.push(r?),
+                None => {
+                    return Err(Error::Domain(
+                        "a training was not run after another failed".into(),
+                    ));
+                }
+            }
+        }
+        Ok(out)
     }
 
     /// The protocol paragraph every section carries.
@@ -259,6 +301,18 @@ impl Ctx<'_> {
                 .unwrap_or_else(|| "none (clean inputs)".into())
         )
     }
+}
+
+/// A trained model and its wall time, s, or why it failed.
+type Fitted = Result<(Model, f64)>;
+
+/// One training of [`Ctx::fit_all`].
+struct FitJob<'d> {
+    ds: &'d DataSet,
+    spec: DataSpec,
+    kind: ModelKind,
+    dir: PathBuf,
+    windows: Option<usize>,
 }
 
 /// The columns the experiments keep (time, labels, the candidates): the rest is dropped.
@@ -327,7 +381,7 @@ fn read_log(dir: &Path) -> Vec<EpochLog> {
 pub fn run(
     which: &[Which],
     opts: &ExperimentOptions,
-    log: &mut dyn FnMut(String),
+    log: &(dyn Fn(String) + Sync),
 ) -> Result<PathBuf> {
     let t0 = Instant::now();
     let plan = Plan::load(&opts.plan)?;

@@ -2,7 +2,7 @@
 //! by side (spec learning.md §4.4), so a reader sees what each number measures and how much a
 //! leaky split inflates it.
 
-use super::{Ctx, f4};
+use super::{Ctx, FitJob, f4};
 use crate::error::Result;
 use crate::features::{NoiseProtocol, Split};
 use crate::learn::evaluate::{EvalPart, evaluate};
@@ -63,19 +63,29 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             },
         ),
     ];
+    let jobs: Vec<FitJob> = splits
+        .iter()
+        .filter(|(name, _)| !(*name == "seeds" && ctx.pooled.is_some()))
+        .map(|(_, split)| FitJob {
+            ds: &dsn,
+            spec: ctx.spec(
+                &inputs,
+                &labels,
+                NoiseProtocol::Matched,
+                split.clone(),
+                Some(opts.snr_db),
+            ),
+            kind: ModelKind::CnnBiLstm,
+            dir: dir.join(format!("models/{}", split.name())),
+            windows: None,
+        })
+        .collect();
+    let mut fitted = ctx.fit_all(&jobs)?.into_iter();
     for (name, split) in splits {
-        let sp = ctx.spec(
-            &inputs,
-            &labels,
-            NoiseProtocol::Matched,
-            split.clone(),
-            Some(opts.snr_db),
-        );
         let e = match (&ctx.pooled, name) {
             (Some(m), "seeds") => m.clone(),
             _ => {
-                let mdir = dir.join(format!("models/{}", split.name()));
-                let (mut m, _) = ctx.fit(&dsn, &sp, ModelKind::CnnBiLstm, &mdir, None)?;
+                let (mut m, _) = fitted.next().expect("one model per split");
                 evaluate(&mut m, &dsn, EvalPart::Test)?.metrics
             }
         };

@@ -2,7 +2,7 @@
 //! CNN-BiLSTM under both noise protocols: trained clean and tested noisy, or trained and
 //! tested at the same SNR.
 
-use super::{Ctx, f4, paper};
+use super::{Ctx, FitJob, f4, paper};
 use crate::error::Result;
 use crate::features::NoiseProtocol;
 use crate::learn::evaluate::{EvalPart, evaluate};
@@ -30,6 +30,48 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     ]);
     let mut charts = Vec::new();
     let windows = Some(opts.condition_windows_per_epoch);
+    let noisy = opts
+        .snrs
+        .iter()
+        .map(|&snr| ctx.noisy(&base, snr, &inputs))
+        .collect::<Result<Vec<_>>>()?;
+    // Every training of the sweep first (clean models, then one per model and SNR), as many
+    // at a time as the options allow; then the tables, in order.
+    let mut jobs = Vec::new();
+    for &kind in &opts.robustness_models {
+        jobs.push(FitJob {
+            ds: &base,
+            spec: ctx.spec(
+                &inputs,
+                &labels,
+                NoiseProtocol::Clean,
+                ctx.split.clone(),
+                None,
+            ),
+            kind,
+            dir: dir.join(format!("models/clean_{}", kind.name())),
+            windows,
+        });
+    }
+    for &kind in &opts.robustness_models {
+        for (dsn, &snr) in noisy.iter().zip(&opts.snrs) {
+            jobs.push(FitJob {
+                ds: dsn,
+                spec: ctx.spec(
+                    &inputs,
+                    &labels,
+                    NoiseProtocol::Matched,
+                    ctx.split.clone(),
+                    Some(snr),
+                ),
+                kind,
+                dir: dir.join(format!("models/matched_{}_{snr}dB", kind.name())),
+                windows,
+            });
+        }
+    }
+    let mut fitted = ctx.fit_all(&jobs)?.into_iter().map(|(m, _)| m);
+    let mut clean: Vec<_> = fitted.by_ref().take(opts.robustness_models.len()).collect();
     for (proto, label) in [
         (
             NoiseProtocol::TrainCleanTestNoisy,
@@ -38,41 +80,17 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         (NoiseProtocol::Matched, "train and test at the SNR"),
     ] {
         let mut series = [Vec::new(), Vec::new()];
-        for &kind in &opts.robustness_models {
+        for (km, &kind) in opts.robustness_models.iter().enumerate() {
             let mut pts = [Vec::new(), Vec::new()];
-            let mut clean_model = if proto == NoiseProtocol::TrainCleanTestNoisy {
-                let sp = ctx.spec(
-                    &inputs,
-                    &labels,
-                    NoiseProtocol::Clean,
-                    ctx.split.clone(),
-                    None,
-                );
-                let dir = dir.join(format!("models/clean_{}", kind.name()));
-                Some(ctx.fit(&base, &sp, kind, &dir, windows)?.0)
-            } else {
-                None
-            };
-            for &snr in &opts.snrs {
-                let dsn = ctx.noisy(&base, snr, &inputs)?;
-                let ev = match clean_model.as_mut() {
-                    Some(m) => {
-                        m.meta.data.noise = NoiseProtocol::TrainCleanTestNoisy;
-                        m.meta.data.noise_model = Some(opts.noise(snr));
-                        evaluate(m, &dsn, EvalPart::Test)?
-                    }
-                    None => {
-                        let sp = ctx.spec(
-                            &inputs,
-                            &labels,
-                            NoiseProtocol::Matched,
-                            ctx.split.clone(),
-                            Some(snr),
-                        );
-                        let mdir = dir.join(format!("models/matched_{}_{snr}dB", kind.name()));
-                        let (mut m, _) = ctx.fit(&dsn, &sp, kind, &mdir, windows)?;
-                        evaluate(&mut m, &dsn, EvalPart::Test)?
-                    }
+            for (dsn, &snr) in noisy.iter().zip(&opts.snrs) {
+                let ev = if proto == NoiseProtocol::TrainCleanTestNoisy {
+                    let m = &mut clean[km];
+                    m.meta.data.noise = NoiseProtocol::TrainCleanTestNoisy;
+                    m.meta.data.noise_model = Some(opts.noise(snr));
+                    evaluate(m, dsn, EvalPart::Test)?
+                } else {
+                    let mut m = fitted.next().expect("one model per kind and SNR");
+                    evaluate(&mut m, dsn, EvalPart::Test)?
                 };
                 let m = &ev.metrics;
                 let paper = if snr == 1.0 && proto == NoiseProtocol::Matched {

@@ -3,7 +3,7 @@
 //! noisy at the experiments' SNR); the CNN-BiLSTM on the union of the two selections is
 //! compared with the paper's 21 at each SNR of the experiment.
 
-use super::{Ctx, f4};
+use super::{Ctx, FitJob, f4};
 use crate::error::Result;
 use crate::features::{NoiseProtocol, SelectOptions, select};
 use crate::learn::evaluate::{EvalPart, evaluate};
@@ -15,7 +15,9 @@ use crate::sensors::{Candidates, clean_name};
 pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let opts = ctx.opts;
     let labels = ctx.labels();
-    let onboard = Candidates::Onboard.among(&ctx.ds.names, &ctx.ds.labels);
+    let onboard = ctx
+        .ds
+        .distinct_channels(&Candidates::Onboard.among(&ctx.ds.names, &ctx.ds.labels));
     let dir = opts.out.join("sensors");
     let dsn = ctx.noisy(&ctx.ds, opts.snr_db, &onboard)?;
     let mut chosen: Vec<String> = Vec::new();
@@ -81,39 +83,71 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         "FQ RMSE kN",
     ]);
     let paper = Ctx::paper21();
-    for &snr in &opts.sensor_snrs {
-        let dsn = ctx.noisy(&ctx.ds, snr, &onboard)?;
-        for (name, inputs) in [("paper's 21", &paper), ("selected on-board", &chosen)] {
-            let sp = ctx.spec(
+    // The noisy data of each SNR (the selection's at the experiments' SNR is reused).
+    let others = opts
+        .sensor_snrs
+        .iter()
+        .map(|&snr| {
+            (snr != opts.snr_db)
+                .then(|| ctx.noisy(&ctx.ds, snr, &onboard))
+                .transpose()
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let sets: Vec<&crate::features::DataSet> =
+        others.iter().map(|o| o.as_ref().unwrap_or(&dsn)).collect();
+    let cases: Vec<(f64, &str, &Vec<String>, usize)> = opts
+        .sensor_snrs
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &snr)| {
+            [("paper's 21", &paper), ("selected on-board", &chosen)]
+                .map(|(name, inputs)| (snr, name, inputs, i))
+        })
+        .collect();
+    let reused =
+        |snr: f64, name: &str| ctx.pooled.is_some() && name == "paper's 21" && snr == opts.snr_db;
+    let jobs: Vec<FitJob> = cases
+        .iter()
+        .filter(|(snr, name, _, _)| !reused(*snr, name))
+        .map(|&(snr, name, inputs, i)| FitJob {
+            ds: sets[i],
+            spec: ctx.spec(
                 inputs,
                 &labels,
                 NoiseProtocol::Matched,
                 ctx.split.clone(),
                 Some(snr),
-            );
-            let tag = if inputs == &paper {
-                "paper21"
-            } else {
-                "selected"
-            };
-            let e = match &ctx.pooled {
-                Some(m) if tag == "paper21" && snr == opts.snr_db => m.clone(),
-                _ => {
-                    let mdir = dir.join(format!("models/{tag}_{snr}dB"));
-                    let (mut m, _) = ctx.fit(&dsn, &sp, ModelKind::CnnBiLstm, &mdir, None)?;
-                    evaluate(&mut m, &dsn, EvalPart::Test)?.metrics
+            ),
+            kind: ModelKind::CnnBiLstm,
+            dir: dir.join(format!(
+                "models/{}_{snr}dB",
+                if name == "paper's 21" {
+                    "paper21"
+                } else {
+                    "selected"
                 }
-            };
-            t.push(vec![
-                name.into(),
-                inputs.len().to_string(),
-                format!("{snr}"),
-                f4(e[0].r2),
-                f4(e[1].r2),
-                format!("{:.2}", e[0].rmse_kn),
-                format!("{:.2}", e[1].rmse_kn),
-            ]);
-        }
+            )),
+            windows: None,
+        })
+        .collect();
+    let mut fitted = ctx.fit_all(&jobs)?.into_iter();
+    for &(snr, name, inputs, i) in &cases {
+        let e = match &ctx.pooled {
+            Some(m) if reused(snr, name) => m.clone(),
+            _ => {
+                let (mut m, _) = fitted.next().expect("one model per case");
+                evaluate(&mut m, sets[i], EvalPart::Test)?.metrics
+            }
+        };
+        t.push(vec![
+            name.into(),
+            inputs.len().to_string(),
+            format!("{snr}"),
+            f4(e[0].r2),
+            f4(e[1].r2),
+            format!("{:.2}", e[0].rmse_kn),
+            format!("{:.2}", e[1].rmse_kn),
+        ]);
     }
     let mut tables = vec![(
         "CNN-BiLSTM (FL and FQ as two outputs), pooled test metrics".into(),
@@ -125,7 +159,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         title: "5. On-board sensor selection (not in the paper)".into(),
         text: vec![
             format!(
-                "Candidates: every on-board measurable signal railforce records ({}): body accelerations, angular rates, track-relative displacements and angles, and the deflections of the spring nests, shear pads, side bearers and centre plates; wheel forces, contact quantities and other wheels' creepages are not candidates. Selected union for FL and FQ ({} channels): {}.",
+                "Candidates: every on-board measurable signal railforce records ({}, a signal recorded under two names counted once): body accelerations, angular rates, track-relative displacements and angles, and the deflections of the spring nests, shear pads, side bearers and centre plates; wheel forces, contact quantities and other wheels' creepages are not candidates. Selected union for FL and FQ ({} channels): {}.",
                 onboard.len(),
                 chosen.len(),
                 chosen.join(", ")

@@ -95,9 +95,8 @@ impl Default for SelectOptions {
 pub fn select(ds: &DataSet, split: &Split, opts: &SelectOptions) -> Result<Selection> {
     let target_name = ds.target_channel(&opts.target);
     let target = ds.channel(&target_name)?;
-    let names: Vec<String> = opts
-        .candidates
-        .among(&ds.names, &ds.labels)
+    let names: Vec<String> = ds
+        .distinct_channels(&opts.candidates.among(&ds.names, &ds.labels))
         .iter()
         .map(|c| if opts.noisy { noisy_name(c) } else { c.clone() })
         .collect();

@@ -145,6 +145,25 @@ impl DataSet {
         }
     }
 
+    /// `names` without the channels that repeat an earlier one of the list value for value on
+    /// every run (one signal recorded under two names, such as the paper's `ws1_acc_y` and
+    /// the body signal `wheelset1_acc_y`: one sensor, one candidate). Unknown names are kept.
+    pub fn distinct_channels(&self, names: &[String]) -> Vec<String> {
+        let mut kept: Vec<(String, Option<usize>)> = Vec::new();
+        for n in names {
+            let c = self.channel(n).ok();
+            let repeats = c.is_some_and(|c| {
+                kept.iter().any(|(_, k)| {
+                    k.is_some_and(|k| self.runs.iter().all(|r| r.columns[k] == r.columns[c]))
+                })
+            });
+            if !repeats {
+                kept.push((n.clone(), c));
+            }
+        }
+        kept.into_iter().map(|(n, _)| n).collect()
+    }
+
     /// The distinct seeds of the runs, ascending.
     pub fn seeds(&self) -> Vec<u64> {
         let s: std::collections::BTreeSet<u64> = self.runs.iter().map(|r| r.seed).collect();
