@@ -168,3 +168,71 @@ fn learning_commands_explain_bad_input() {
     let (ok, out, _) = railforce(&["validate", "identify", "--help"]);
     assert!(ok && out.contains("never used in training"), "{out}");
 }
+
+/// On-board selection on a noised data set, then training on the selection: the copies the
+/// data set lacks are drawn with its noise, and the model records that noise and the split.
+#[test]
+fn select_onboard_then_train_on_noisy_inputs() {
+    let plan = tmp("onboard.plan.toml");
+    let root = env!("CARGO_MANIFEST_DIR");
+    std::fs::write(
+        &plan,
+        format!(
+            "name = \"onboard\"\nvehicle = \"{root}/vehicles/c80.toml\"\nduration_s = 0.4\nseeds = [1, 2, 3]\n\
+             [[condition]]\nname = \"tangent\"\ntrack = \"{root}/tracks/tangent.toml\"\nspeed_kmh = 60.0\n"
+        ),
+    )
+    .unwrap();
+    let data = tmp("onboard_data");
+    let (ok, _, err) = railforce(&[
+        "generate",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--out",
+        data.to_str().unwrap(),
+        "--snr-db",
+        "6",
+        "--settle",
+        "0.1",
+    ]);
+    assert!(ok, "{err}");
+    let sel = tmp("onboard_sel.json");
+    let (ok, out, err) = railforce(&[
+        "select",
+        "--data",
+        data.to_str().unwrap(),
+        "--candidates",
+        "onboard",
+        "--noisy",
+        "--out",
+        sel.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("drawing the noisy copies"), "{err}");
+    assert!(out.contains("split by seed"), "{out}");
+    let model = tmp("onboard_model");
+    let (ok, _, err) = railforce(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--selection",
+        sel.to_str().unwrap(),
+        "--model",
+        "tree",
+        "--target",
+        "FQ",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(model.join("model.json")).unwrap()).unwrap();
+    assert_eq!(meta["data"]["noise"], "Matched");
+    assert_eq!(meta["data"]["noise_model"]["snr_db"], 6.0);
+    assert_eq!(meta["data"]["noise_model"]["reference"], "std");
+    assert!(
+        meta["data"]["split"]["seeds"].is_object(),
+        "{}",
+        meta["data"]["split"]
+    );
+}

@@ -20,7 +20,9 @@ pub struct SelectArgs {
     /// Stop the wrapper when the best validation-R² gain is below this.
     #[arg(long, default_value_t = 0.002)]
     tolerance: f64,
-    /// Select among the `_noisy` input copies (the data set must have them: generate --snr-db).
+    /// Select among the `_noisy` copies of the candidates. The data set must be noised
+    /// (generate --snr-db); copies it lacks (the on-board candidates: generate noises the
+    /// paper's 21) are drawn in memory with its noise model.
     #[arg(long)]
     noisy: bool,
     /// Window length, steps.
@@ -45,7 +47,13 @@ pub struct SelectArgs {
 
 pub fn run(args: SelectArgs) -> Result<()> {
     let t0 = std::time::Instant::now();
-    let ds = DataSet::load(&args.data)?;
+    let mut ds = DataSet::load(&args.data)?;
+    let candidates = Candidates::parse(&args.candidates).unwrap_or(Candidates::Paper21);
+    if args.noisy {
+        let wanted = candidates.among(&ds.names, &ds.labels);
+        let noise = ds.noise;
+        ds = super::train::with_noisy_copies(ds, &wanted, noise)?;
+    }
     let opts = SelectOptions {
         target: args.target.clone(),
         noisy: args.noisy,
@@ -57,7 +65,7 @@ pub fn run(args: SelectArgs) -> Result<()> {
         } else {
             LabelAt::Last
         },
-        candidates: Candidates::parse(&args.candidates).unwrap_or(Candidates::Paper21),
+        candidates,
         mi_samples: args.mi_samples,
         ..SelectOptions::default()
     };

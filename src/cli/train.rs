@@ -137,9 +137,12 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
         "both" => ds.labels.to_vec(),
         t => vec![ds.target_channel(t)],
     };
-    let has_noisy = channels
-        .iter()
-        .all(|c| ds.channel(&format!("{c}_noisy")).is_ok());
+    // A noised data set (generate --snr-db) trains on noisy inputs; copies it lacks (the
+    // on-board candidates) are drawn in memory with its noise model (see `with_noisy_copies`).
+    let has_noisy = ds.noise.is_some()
+        || channels
+            .iter()
+            .all(|c| ds.channel(&format!("{c}_noisy")).is_ok());
     let noise = match args.noise.as_deref() {
         None if has_noisy => NoiseProtocol::Matched,
         None => NoiseProtocol::Clean,
@@ -223,10 +226,44 @@ pub fn split(args: &DataArgs, ds: &DataSet) -> Result<Split> {
     Ok(split)
 }
 
+/// `ds` with `<channel>_noisy` copies of every channel of `channels` that lacks one, drawn
+/// with `noise` (seeded per run and channel name, as `generate` draws them); unchanged when
+/// none is missing.
+pub fn with_noisy_copies(
+    ds: DataSet,
+    channels: &[String],
+    noise: Option<railforce::sensors::NoiseModel>,
+) -> Result<DataSet> {
+    let missing = channels
+        .iter()
+        .filter(|c| ds.channel(&railforce::sensors::noisy_name(c)).is_err())
+        .count();
+    if missing == 0 {
+        return Ok(ds);
+    }
+    let noise = noise.with_context(|| {
+        format!(
+            "{} has no noisy copies of {missing} input channels and records no noise (generate with --snr-db)",
+            ds.dir.display()
+        )
+    })?;
+    eprintln!(
+        "note: drawing the noisy copies of {missing} channels in memory: {}",
+        noise.describe()
+    );
+    Ok(ds.with_noise(noise, channels)?)
+}
+
 pub fn run(args: TrainArgs) -> Result<()> {
     let kind = ModelKind::parse(&args.model)?;
     let ds = DataSet::load(&args.data.data)?;
     let spec = data_spec(&args.data, &ds)?;
+    let ds = if spec.noise == NoiseProtocol::Clean {
+        ds
+    } else {
+        let noise = ds.noise;
+        with_noisy_copies(ds, &spec.channels, noise)?
+    };
     let opts = TrainOptions {
         epochs: args.epochs,
         patience: args.patience,
@@ -340,25 +377,10 @@ pub struct EvaluateArgs {
 pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
     let mut model = Model::load(&args.model)?;
     let mut ds = DataSet::load(&args.data)?;
-    // A model that reads noisy inputs, on a clean data set: noise it as the model was noised
-    // (its recorded SNR and reference), seeded per run and channel as `generate` does.
-    let reads_noisy = model.meta.data.noise != NoiseProtocol::Clean;
-    let has_noisy = model
-        .meta
-        .data
-        .channels
-        .iter()
-        .all(|c| ds.channel(&railforce::sensors::noisy_name(c)).is_ok());
-    if reads_noisy
-        && !has_noisy
-        && let Some(noise) = model.meta.data.noise_model
-    {
-        eprintln!(
-            "note: {} has no noisy inputs; adding them as the model was trained: {}",
-            args.data.display(),
-            noise.describe()
-        );
-        ds = ds.with_noise(noise, &model.meta.data.channels)?;
+    // A model that reads noisy inputs, on a data set without them: noise it as the model was
+    // noised (its recorded SNR and reference), seeded per run and channel as `generate` does.
+    if model.meta.data.noise != NoiseProtocol::Clean {
+        ds = with_noisy_copies(ds, &model.meta.data.channels, model.meta.data.noise_model)?;
     }
     let part = if args.all {
         EvalPart::All
