@@ -105,6 +105,13 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
             args.out.display(),
             sp.display()
         );
+        if let Some(n) = model.meta.data.noise_model {
+            eprintln!(
+                "the model was trained on inputs at {} dB (σ from each channel's {}): it expects sensor signals about that noisy; `validate identify` checks it at that SNR",
+                n.snr_db,
+                n.reference.name()
+            );
+        }
     }
     print_safety(&reports);
     Ok(())
