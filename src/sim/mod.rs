@@ -442,11 +442,4 @@ impl<'a> Simulation<'a> {
     }
 }
 
-/// Name of wheel `k` (0 → `1L`, 1 → `1R`, 2 → `2L`, …).
-pub fn wheel_name(k: usize) -> String {
-    format!(
-        "{}{}",
-        k / 2 + 1,
-        if k.is_multiple_of(2) { 'L' } else { 'R' }
-    )
-}
+pub use crate::vehicle::wheel_name;

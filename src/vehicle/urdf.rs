@@ -1,0 +1,61 @@
+//! The bodies of a vehicle from its URDF file.
+
+use super::body::Body;
+use crate::error::{Error, Result};
+use nalgebra::Vector3;
+use std::path::Path;
+
+/// Reads the bodies of a URDF file: each link with an inertial (mass > 0), placed by the origin
+/// of the joint that attaches it to the root (floating joints from a massless reference link).
+pub(super) fn read_urdf(path: &Path) -> Result<Vec<Body>> {
+    let robot = urdf_rs::read_file(path).map_err(|e| Error::Parse {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let mut bodies = Vec::new();
+    for link in &robot.links {
+        let inertial = &link.inertial;
+        let m = inertial.mass.value;
+        let is_root = !robot.joints.iter().any(|j| j.child.link == link.name);
+        if is_root && m == 0.0 {
+            continue; // the massless reference frame the bodies hang from
+        }
+        let err = |field: &str, msg: String| {
+            Error::config(path, format!("link \"{}\".{field}", link.name), msg)
+        };
+        if !(m.is_finite() && m > 0.0) {
+            return Err(err("mass", format!("must be positive, got {m}")));
+        }
+        let i = &inertial.inertia;
+        for (name, v) in [("ixx", i.ixx), ("iyy", i.iyy), ("izz", i.izz)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(err(
+                    &format!("inertia.{name}"),
+                    format!("must be positive, got {v}"),
+                ));
+            }
+        }
+        if i.ixy != 0.0 || i.ixz != 0.0 || i.iyz != 0.0 {
+            return Err(err(
+                "inertia",
+                "give principal moments (products of inertia 0)".into(),
+            ));
+        }
+        let joint = robot.joints.iter().find(|j| j.child.link == link.name);
+        let origin = joint.map(|j| *j.origin.xyz).unwrap_or([0.0; 3]);
+        let com = *inertial.origin.xyz;
+        bodies.push(Body {
+            name: link.name.clone(),
+            mass: m,
+            inertia: Vector3::new(i.ixx, i.iyy, i.izz),
+            position: Vector3::from(origin) + Vector3::from(com),
+        });
+    }
+    if bodies.is_empty() {
+        return Err(Error::Parse {
+            file: path.to_path_buf(),
+            message: "no link with a positive mass".into(),
+        });
+    }
+    Ok(bodies)
+}
