@@ -473,3 +473,40 @@ fn sections_are_contiguous_from_zero() {
         Some(IrregularitySpec { seed: 1, .. })
     ));
 }
+
+/// Issue 17: the synthesised gauge never leaves its class's limits (49 CFR 213.53: never
+/// narrower than 4 ft 8 in, −12.7 mm), sampled finely between the grid points too, while the
+/// rest of the signal keeps its PSD level.
+#[test]
+fn gauge_stays_within_its_class_limits() {
+    use railforce::track::irregularity::{Channel, FraClass, soft_limit};
+    for class in [4, 5] {
+        let text = format!(
+            "name = \"g\"\nrail_spacing_m = 1.5\ngauge_m = 1.435\n[[section]]\nkind = \"tangent\"\nlength_m = 3000.0\n[irregularity]\nclass = {class}\nseed = 1\n"
+        );
+        let spec = TrackSpec::parse(&text, std::path::Path::new("g.toml")).unwrap();
+        let (lo, hi) = FraClass::new(class).unwrap().gauge_limits();
+        assert!((lo + 12.7e-3).abs() < 1e-9);
+        let track = railforce::track::Track::new(spec, None);
+        let irr = track.irregularities().unwrap();
+        let [raw_min, _, _] = irr.gauge_before_limit();
+        // Seed 1 goes beyond the limit before it is held (−16 mm class 5, −20 mm class 4).
+        assert!(raw_min < lo, "class {class}: raw minimum {raw_min}");
+        let mut least = f64::INFINITY;
+        for i in 0..300_000 {
+            let s = i as f64 * 0.01;
+            let g = irr.channel_at(Channel::Gauge, s).0;
+            least = least.min(g);
+            assert!(g > lo && g < hi, "class {class}: gauge {g} at s = {s}");
+        }
+        assert!(least < 0.8 * lo, "class {class}: least gauge {least}");
+    }
+    // The knee: identity inside 75 % of the limit, continuous slope, never reaching it.
+    assert_eq!(soft_limit(-5e-3, -12.7e-3, 19.05e-3), -5e-3);
+    let (a, b) = (
+        soft_limit(-0.75 * 12.7e-3 - 1e-9, -12.7e-3, 1.0),
+        soft_limit(-0.75 * 12.7e-3 + 1e-9, -12.7e-3, 1.0),
+    );
+    assert!(((b - a) / 2e-9 - 1.0).abs() < 1e-3);
+    assert!(soft_limit(-1.0, -12.7e-3, 1.0) >= -12.7e-3);
+}

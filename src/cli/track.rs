@@ -66,6 +66,23 @@ pub fn run(args: TrackArgs) -> Result<()> {
                 100.0 * c.deviation()
             );
         }
+        let [raw_min, raw_max, raw_rms] = irr.gauge_before_limit();
+        let g = irr.channel_samples(Channel::Gauge);
+        let rms = (g.iter().map(|v| v * v).sum::<f64>() / g.len() as f64).sqrt();
+        let (lo, hi) = sp.gauge_limits;
+        println!(
+            "  gauge held within {:+.1} / {:+.1} mm (49 CFR 213.53, class {}) by a soft limit (knee at 75 %): \
+             synthesised {:+.1} to {:+.1} mm, RMS {:.2} mm → {:+.1} to {:+.1} mm, RMS {:.2} mm",
+            lo * 1e3,
+            hi * 1e3,
+            sp.class.number,
+            raw_min * 1e3,
+            raw_max * 1e3,
+            raw_rms * 1e3,
+            g.iter().cloned().fold(f64::INFINITY, f64::min) * 1e3,
+            g.iter().cloned().fold(f64::NEG_INFINITY, f64::max) * 1e3,
+            rms * 1e3
+        );
         let two_pi = 2.0 * std::f64::consts::PI;
         let (w_lo, w_hi) = (two_pi / sp.max_wavelength, two_pi / sp.min_wavelength);
         let cmp = check::psd_comparison(irr, track.length());

@@ -79,6 +79,10 @@ struct IrregularityFile {
     smooth_start_m: f64,
     #[serde(default = "default_fade_in")]
     fade_in_m: f64,
+    /// Narrowest gauge deviation, mm (default: the class's limit, 49 CFR 213.53).
+    gauge_min_mm: Option<f64>,
+    /// Widest gauge deviation, mm (default: the class's limit).
+    gauge_max_mm: Option<f64>,
 }
 
 fn default_smooth_start() -> f64 {
@@ -306,7 +310,13 @@ impl TrackSpec {
                     0.0,
                     1000.0,
                 )?;
+                let (lo, hi) = class.gauge_limits();
+                let lo = irr.gauge_min_mm.map_or(lo, |v| v * 1e-3);
+                let hi = irr.gauge_max_mm.map_or(hi, |v| v * 1e-3);
+                check_range(path, "irregularity.gauge_min_mm", lo * 1e3, -50.0, -1.0)?;
+                check_range(path, "irregularity.gauge_max_mm", hi * 1e3, 1.0, 50.0)?;
                 Some(IrregularitySpec {
+                    gauge_limits: (lo, hi),
                     smooth_start: irr.smooth_start_m,
                     class,
                     min_wavelength: irr.min_wavelength_m,

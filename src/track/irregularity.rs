@@ -44,6 +44,20 @@ const FRA_TABLE: [(f64, f64, f64, f64); 6] = [
 ];
 
 impl FraClass {
+    /// Gauge limits of the class relative to the 1 435 mm (4 ft 8½ in) nominal, m: (narrowest,
+    /// widest). US 49 CFR 213.53: never below 4 ft 8 in for any class (−12.7 mm); at most
+    /// 4 ft 9¾ in (class 1), 4 ft 9½ in (2–3), 4 ft 9¼ in (4–5), 4 ft 9 in (6).
+    pub fn gauge_limits(&self) -> (f64, f64) {
+        let inch = 25.4e-3;
+        let widest = match self.number {
+            1 => 1.25,
+            2 | 3 => 1.0,
+            4 | 5 => 0.75,
+            _ => 0.5,
+        };
+        (-0.5 * inch, widest * inch)
+    }
+
     /// The class with this number, or `None` outside 1–6.
     pub fn new(number: i64) -> Option<Self> {
         let idx = usize::try_from(number).ok()?.checked_sub(1)?;
@@ -144,6 +158,26 @@ pub struct IrregularitySpec {
     /// Length over which the irregularities then fade in from zero (raised cosine), m:
     /// vehicles start on smooth rails and settle onto the irregularities.
     pub fade_in: f64,
+    /// Narrowest and widest gauge deviation allowed, m (default: the class's
+    /// [`FraClass::gauge_limits`]). The synthesised gauge is held inside by [`soft_limit`].
+    pub gauge_limits: (f64, f64),
+}
+
+/// Holds `x` inside `(lo, hi)` (lo < 0 < hi) with a smooth knee: unchanged within 75 % of each
+/// limit, beyond it `k + (L − k)·tanh((x − k)/(L − k))` (k the knee, L the limit), which
+/// meets the identity with the same slope at the knee and never goes beyond L. Track that narrow or
+/// wide is not in service (it would be repaired), so the PSD's rare extremes are bent back,
+/// not cut: the rest of the signal and its derivative stay continuous.
+pub fn soft_limit(x: f64, lo: f64, hi: f64) -> f64 {
+    let bend = |x: f64, l: f64| {
+        let k = 0.75 * l;
+        if x.abs() <= k.abs() {
+            x
+        } else {
+            k + (l - k) * ((x - k) / (l - k)).tanh()
+        }
+    };
+    if x >= 0.0 { bend(x, hi) } else { bend(x, lo) }
 }
 
 /// Offsets of both rails at one position, m, with their derivatives along the track (1/1).
@@ -176,6 +210,8 @@ pub struct Irregularities {
     origin: f64,
     /// Samples per channel (order of [`Channel::ALL`]) at `s = origin + i·dx`.
     samples: [Vec<f64>; 4],
+    /// The synthesised gauge before the limit: least, greatest and RMS, m.
+    gauge_raw: [f64; 3],
 }
 
 impl Irregularities {
@@ -196,6 +232,7 @@ impl Irregularities {
         let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
         let phase = Uniform::new(0.0, 2.0 * PI).expect("valid range");
         let fft = FftPlanner::<f64>::new().plan_fft_inverse(n_fft);
+        let mut gauge_raw = [0.0; 3];
         let samples = Channel::ALL.map(|ch| {
             let mut buf = vec![Complex64::new(0.0, 0.0); n_fft];
             for (k, b) in buf.iter_mut().enumerate().take(k_hi + 1).skip(k_lo) {
@@ -204,14 +241,35 @@ impl Irregularities {
             }
             fft.process(&mut buf);
             buf.truncate(n_pts);
-            buf.into_iter().map(|c| c.re).collect()
+            let (lo, hi) = spec.gauge_limits;
+            if ch == Channel::Gauge {
+                let n = buf.len() as f64;
+                gauge_raw = [
+                    buf.iter().map(|c| c.re).fold(f64::INFINITY, f64::min),
+                    buf.iter().map(|c| c.re).fold(f64::NEG_INFINITY, f64::max),
+                    (buf.iter().map(|c| c.re * c.re).sum::<f64>() / n).sqrt(),
+                ];
+            }
+            buf.into_iter()
+                .map(|c| match ch {
+                    Channel::Gauge => soft_limit(c.re, lo, hi),
+                    _ => c.re,
+                })
+                .collect()
         });
         Irregularities {
             spec,
             dx,
             origin: -2.0 * dx,
             samples,
+            gauge_raw,
         }
+    }
+
+    /// The synthesised gauge deviation before [`soft_limit`] held it inside
+    /// [`IrregularitySpec::gauge_limits`]: least, greatest and RMS over the grid, m.
+    pub fn gauge_before_limit(&self) -> [f64; 3] {
+        self.gauge_raw
     }
 
     /// The settings they were made with.
