@@ -87,6 +87,8 @@ pub struct Simulation<'a> {
     table: &'a crate::contact::ContactTable,
     states: Vec<BodyState>,
     wrenches: Vec<Wrench>,
+    /// Internal state of each force element (wedge sliders).
+    memory: Vec<crate::vehicle::elements::Memory>,
     /// Along-track position of every body, m.
     body_s: Vec<f64>,
     /// Track frame at each body (wheelsets and hauled body every step, others on demand).
@@ -218,6 +220,7 @@ impl<'a> Simulation<'a> {
             table,
             states,
             wrenches: vec![Wrench::default(); n],
+            memory: vec![[0.0; 4]; vehicle.elements.len()],
             body_s,
             last_approach: vec![[f64::NAN; 2]; n_wheels],
             over_nadal: vec![0.0; n_wheels],
@@ -285,8 +288,8 @@ impl<'a> Simulation<'a> {
             w.force.z = -b.mass * g;
             let _ = s;
         }
-        for e in &self.vehicle.elements {
-            e.apply(&self.states, &mut self.wrenches);
+        for (e, m) in self.vehicle.elements.iter().zip(&mut self.memory) {
+            e.apply(&self.states, m, &mut self.wrenches);
         }
         // Wheelsets (contact) and the hauled body need their track frame every step; the
         // others only when signals are sampled or the state is checked.

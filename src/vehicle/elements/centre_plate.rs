@@ -8,6 +8,9 @@
 use super::Relative;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
 use nalgebra::Vector3;
+use crate::error::Result;
+use crate::vehicle::binder::Binder;
+use serde::Deserialize;
 
 /// Centre plate between the carbody (upper) and a bolster (lower).
 #[derive(Debug, Clone, PartialEq)]
@@ -65,5 +68,41 @@ impl CentrePlate {
             * (rel_yaw_rate / self.regularisation_rate).tanh();
         wrenches[self.upper.body].torque += up * torque;
         wrenches[self.lower.body].torque -= up * torque;
+    }
+}
+
+/// `[[centre_plate]]` in a vehicle file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct CentrePlateFile {
+    upper: String,
+    lower: String,
+    at: [f64; 3],
+    stiffness: [f64; 3],
+    #[serde(default)]
+    damping: [f64; 3],
+    friction: f64,
+    radius_m: f64,
+    regularisation_rate: f64,
+}
+
+impl CentrePlate {
+    pub(crate) fn bind(f: &str, e: &CentrePlateFile, b: &Binder) -> Result<Self> {
+        b.non_negative(format!("{f}.stiffness"), &e.stiffness)?;
+        b.non_negative(format!("{f}.damping"), &e.damping)?;
+        b.non_negative(format!("{f}.friction"), &[e.friction])?;
+        b.positive(format!("{f}.radius_m"), e.radius_m)?;
+        b.positive(format!("{f}.regularisation_rate"), e.regularisation_rate)?;
+        let (upper, lower) = b.pair(f, &e.upper, &e.lower, e.at)?;
+        Ok(CentrePlate {
+            upper,
+            lower,
+            stiffness: Vector3::from(e.stiffness),
+            damping: Vector3::from(e.damping),
+            friction: e.friction,
+            radius: e.radius_m,
+            regularisation_rate: e.regularisation_rate,
+            preload: 0.0,
+        })
     }
 }

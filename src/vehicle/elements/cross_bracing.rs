@@ -6,6 +6,9 @@
 
 use crate::vehicle::body::{BodyState, Wrench};
 use nalgebra::Vector3;
+use crate::error::Result;
+use crate::vehicle::binder::Binder;
+use serde::Deserialize;
 
 /// Cross-bracing between the left and right side frames of one bogie.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,5 +53,25 @@ impl CrossBracing {
         wrenches[self.right].force += f;
         wrenches[self.left].torque.z -= 0.5 * m;
         wrenches[self.right].torque.z -= 0.5 * m;
+    }
+}
+
+/// `[[cross_bracing]]` in a vehicle file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct CrossBracingFile {
+    left: String,
+    right: String,
+    warp_stiffness: f64,
+}
+
+impl CrossBracing {
+    pub(crate) fn bind(f: &str, e: &CrossBracingFile, b: &Binder) -> Result<Self> {
+        b.non_negative(format!("{f}.warp_stiffness"), &[e.warp_stiffness])?;
+        Ok(CrossBracing {
+            left: b.find(format!("{f}.left"), &e.left)?,
+            right: b.find(format!("{f}.right"), &e.right)?,
+            warp_stiffness: e.warp_stiffness,
+        })
     }
 }

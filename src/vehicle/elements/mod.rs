@@ -6,6 +6,7 @@
 
 mod centre_plate;
 mod cross_bracing;
+mod lateral_stop;
 mod shear_pad;
 mod side_bearer;
 mod spring_nest;
@@ -14,11 +15,25 @@ mod wedge_damper;
 
 pub use centre_plate::CentrePlate;
 pub use cross_bracing::CrossBracing;
+pub use lateral_stop::LateralStop;
 pub use shear_pad::ShearPad;
 pub use side_bearer::SideBearer;
 pub use spring_nest::{NestLaw, SpringNest};
 pub use track_spring::TrackSpring;
-pub use wedge_damper::WedgeDamper;
+pub use wedge_damper::{WedgeDamper, slider};
+
+pub(crate) use centre_plate::CentrePlateFile;
+pub(crate) use cross_bracing::CrossBracingFile;
+pub(crate) use lateral_stop::LateralStopFile;
+pub(crate) use shear_pad::ShearPadFile;
+pub(crate) use side_bearer::SideBearerFile;
+pub(crate) use spring_nest::SpringNestFile;
+pub(crate) use track_spring::TrackSpringFile;
+pub(crate) use wedge_damper::WedgeDamperFile;
+
+/// Internal state of an element that has one (the sliders of a wedge), zero at the static
+/// position; the simulation keeps one per element.
+pub type Memory = [f64; 4];
 
 use super::body::{Attachment, BodyState, Wrench};
 use nalgebra::{Matrix3, Vector3};
@@ -38,18 +53,22 @@ pub enum Element {
     SideBearer(SideBearer),
     /// Cross-bracing between the two side frames of a bogie.
     CrossBracing(CrossBracing),
+    /// Lateral stop with clearance (bolster gibs ↔ side frame).
+    LateralStop(LateralStop),
     /// Lateral and yaw spring to the track (Wickens' restrained wheelset).
     TrackSpring(TrackSpring),
 }
 
 impl Element {
-    /// Adds this element's forces to the wrenches of the bodies it connects.
+    /// Adds this element's forces to the wrenches of the bodies it connects, updating its
+    /// internal state (`memory`, used by elements with sliders).
     #[inline]
-    pub fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
+    pub fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
         match self {
             Element::ShearPad(e) => e.apply(states, wrenches),
             Element::SpringNest(e) => e.apply(states, wrenches),
-            Element::WedgeDamper(e) => e.apply(states, wrenches),
+            Element::WedgeDamper(e) => e.apply(states, memory, wrenches),
+            Element::LateralStop(e) => e.apply(states, wrenches),
             Element::CentrePlate(e) => e.apply(states, wrenches),
             Element::SideBearer(e) => e.apply(states, wrenches),
             Element::CrossBracing(e) => e.apply(states, wrenches),
@@ -108,6 +127,7 @@ impl Element {
             Element::CentrePlate(_) => "centre_plate",
             Element::SideBearer(_) => "side_bearer",
             Element::CrossBracing(_) => "cross_bracing",
+            Element::LateralStop(_) => "lateral_stop",
             Element::TrackSpring(_) => "track_spring",
         }
     }

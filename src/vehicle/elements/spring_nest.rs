@@ -9,6 +9,9 @@
 use super::Relative;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
 use nalgebra::Vector3;
+use crate::error::Result;
+use crate::vehicle::binder::Binder;
+use serde::Deserialize;
 
 /// Vertical force–compression law of a two-stage nest.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -104,5 +107,41 @@ impl SpringNest {
         let m_world = r.axes * m;
         wrenches[self.upper.body].torque += m_world;
         wrenches[self.lower.body].torque -= m_world;
+    }
+}
+
+/// `[[spring_nest]]` in a vehicle file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SpringNestFile {
+    upper: String,
+    lower: String,
+    at: [f64; 3],
+    vertical_stiffness: [f64; 2],
+    first_stage_travel_m: f64,
+    lateral_stiffness: f64,
+    footprint_m: [f64; 2],
+}
+
+impl SpringNest {
+    pub(crate) fn bind(f: &str, e: &SpringNestFile, b: &Binder) -> Result<Self> {
+        b.positive(format!("{f}.vertical_stiffness"), e.vertical_stiffness[0])?;
+        b.positive(format!("{f}.vertical_stiffness"), e.vertical_stiffness[1])?;
+        b.non_negative(format!("{f}.lateral_stiffness"), &[e.lateral_stiffness])?;
+        b.positive(format!("{f}.first_stage_travel_m"), e.first_stage_travel_m)?;
+        b.non_negative(format!("{f}.footprint_m"), &e.footprint_m)?;
+        let (upper, lower) = b.pair(f, &e.upper, &e.lower, e.at)?;
+        Ok(SpringNest {
+            upper,
+            lower,
+            law: NestLaw {
+                k1: e.vertical_stiffness[0],
+                k2: e.vertical_stiffness[1],
+                travel1: e.first_stage_travel_m,
+            },
+            lateral_stiffness: e.lateral_stiffness,
+            static_compression: 0.0,
+            footprint: e.footprint_m,
+        })
     }
 }

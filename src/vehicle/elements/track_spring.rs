@@ -4,6 +4,9 @@
 
 use crate::vehicle::body::{BodyState, Wrench};
 use nalgebra::Matrix3;
+use crate::error::Result;
+use crate::vehicle::binder::Binder;
+use serde::Deserialize;
 
 /// Lateral and yaw spring between a body and the track frame at its position.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,5 +37,28 @@ impl TrackSpring {
         let up = axes.column(2).into_owned();
         wrenches[self.body].force -= lateral * (self.lateral_stiffness * rel.y);
         wrenches[self.body].torque -= up * (self.yaw_stiffness * yaw);
+    }
+}
+
+/// `[[track_spring]]` in a vehicle file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct TrackSpringFile {
+    link: String,
+    lateral_stiffness: f64,
+    yaw_stiffness: f64,
+}
+
+impl TrackSpring {
+    pub(crate) fn bind(f: &str, e: &TrackSpringFile, b: &Binder) -> Result<Self> {
+        b.non_negative(
+            format!("{f}.lateral_stiffness"),
+            &[e.lateral_stiffness, e.yaw_stiffness],
+        )?;
+        Ok(TrackSpring {
+            body: b.find(format!("{f}.link"), &e.link)?,
+            lateral_stiffness: e.lateral_stiffness,
+            yaw_stiffness: e.yaw_stiffness,
+        })
     }
 }
