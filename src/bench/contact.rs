@@ -1,53 +1,62 @@
-//! Speed of one wheel's contact evaluation during a simulation step.
+//! Speed of one wheel's contact evaluation during a simulation step: the same function a run
+//! executes ([`crate::contact::evaluate`]), on the vehicle's own contact table.
 
-use crate::contact::{CreepLaw, Material, Side, WheelsetGeometry, WheelsetMotion, wheel_force};
+use crate::contact::{CreepLaw, Side, WheelOnRail, evaluate, height_for_load};
+use crate::vehicle::Vehicle;
 use std::hint::black_box;
 use std::time::Instant;
 
 /// Result of the contact benchmark.
 #[derive(Debug, Clone, Copy)]
 pub struct ContactBench {
-    /// One wheel: table lookup + Hertz + creepages + Polach + force assembly, ns.
+    /// One wheel: strip contact + Hertz + creepages + Polach + force assembly, ns.
     pub wheel_polach_ns: f64,
     /// The same with FASTSIM (60 × 60) instead of Polach, ns: the reference.
     pub wheel_fastsim_ns: f64,
     /// One rigid contact solve of both wheels (what the table saves), ns.
     pub rigid_solve_ns: f64,
-    /// Time to build the contact table (±15 mm every 0.1 mm), s.
+    /// Time to build the vehicle's contact table with its strips, s.
     pub table_build_s: f64,
 }
 
-/// Runs the benchmark on a wheelset geometry (the vehicle file's), at 122.6 kN and 60 km/h.
-pub fn run(geo: &WheelsetGeometry, iterations: usize) -> ContactBench {
+/// Runs the benchmark on a vehicle's contact (its table and settings), at 122.6 kN and
+/// 60 km/h, sweeping the lateral shift over ±6 mm.
+pub fn run(vehicle: &Vehicle, iterations: usize) -> ContactBench {
+    let cs = &vehicle.contact;
     let t = Instant::now();
-    let table = geo.table(15e-3, 1e-4);
+    let table = cs.table();
     let table_build_s = t.elapsed().as_secs_f64();
-    let mat = Material::STEEL;
-    let motion = WheelsetMotion {
-        lateral_velocity: 0.05,
-        yaw_rate: 0.01,
-        yaw: 1e-3,
-        ..WheelsetMotion::rolling(16.7, geo.nominal_radius)
-    };
+    let geo = &cs.geometry;
+    let mass = 0.5 * vehicle.bodies[cs.wheelsets[0]].mass;
+    let mut base = WheelOnRail::rolling(Side::Left, 16.7, geo.nominal_radius, 0.0, mass);
+    base.velocity[1] = 0.05;
+    base.angular_velocity[2] = 0.01;
+    base.yaw = 1e-3;
     let time_wheel = |law: CreepLaw, n: usize| {
+        let model = crate::contact::ContactModel {
+            law,
+            ..cs.model()
+        };
+        // Heights that carry the load, every 0.12 mm of shift (not timed).
+        let heights: Vec<f64> = (0..100)
+            .map(|i| {
+                let w = WheelOnRail {
+                    y: -6e-3 + 12e-3 * i as f64 / 100.0,
+                    ..base
+                };
+                height_for_load(table, &model, &w, 122.6e3)
+            })
+            .collect();
         let t = Instant::now();
         let mut acc = 0.0;
         for i in 0..n {
-            // Sweep the lateral shift so the lookup is not a cache of one entry.
-            let y = -6e-3 + 12e-3 * (i % 997) as f64 / 997.0;
-            let s = table.lookup(black_box(y));
-            let f = wheel_force(
-                Side::Left,
-                &s.wheels[0],
-                [0.0, y, s.z],
-                s.roll,
-                &motion,
-                black_box(122.6e3),
-                0.3,
-                &mat,
-                law,
-            );
-            acc += f.force[1];
+            let j = i % 100;
+            let w = WheelOnRail {
+                y: black_box(-6e-3 + 12e-3 * j as f64 / 100.0),
+                height: heights[j],
+                ..base
+            };
+            acc += evaluate(table, &model, &w).force[1];
         }
         black_box(acc);
         t.elapsed().as_secs_f64() * 1e9 / n as f64

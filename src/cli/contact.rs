@@ -3,8 +3,10 @@
 use anyhow::{Result, bail};
 use clap::Args;
 use railforce::contact::{
-    CreepLaw, Material, Side, WheelsetGeometry, WheelsetMotion, profile, split_load, wheel_force,
+    CREEP_SPEED_FLOOR, ContactModel, CreepLaw, Material, Side, WheelOnRail, WheelsetGeometry,
+    evaluate, height_for_load, profile,
 };
+use std::path::PathBuf;
 
 /// Wheel, rail and wheelset description shared by contact commands.
 #[derive(Debug, Args)]
@@ -57,6 +59,11 @@ impl WheelsetArgs {
 
 #[derive(Debug, Args)]
 pub struct ContactArgs {
+    /// Vehicle file: use its wheel and rail profiles, gauge, contact table and contact settings
+    /// (friction, creep law, material, damping), exactly what its runs compute. Without it the
+    /// wheelset options below describe the contact.
+    #[arg(long)]
+    vehicle: Option<PathBuf>,
     #[command(flatten)]
     wheelset: WheelsetArgs,
     /// Lateral shift of the wheelset, mm (+ to the left).
@@ -65,9 +72,12 @@ pub struct ContactArgs {
     /// Yaw angle, mrad (+ turning left).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw_mrad: f64,
-    /// Normal load per wheel, kN.
+    /// Vertical load per wheel, kN: the wheelset height is found at which each wheel carries it.
     #[arg(long, default_value_t = 122.6)]
     load_kn: f64,
+    /// Wheelset roll relative to the rail plane, mrad, beyond the rigid roll at this shift.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    extra_roll_mrad: f64,
     /// Forward speed, km/h.
     #[arg(long, default_value_t = 60.0)]
     speed_kmh: f64,
@@ -81,10 +91,10 @@ pub struct ContactArgs {
     /// Yaw rate, rad/s.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw_rate: f64,
-    /// Friction coefficient.
+    /// Friction coefficient (without --vehicle).
     #[arg(long, default_value_t = 0.3)]
     mu: f64,
-    /// Creep force law: polach, fastsim or linear.
+    /// Creep force law: polach, fastsim or linear (without --vehicle).
     #[arg(long, default_value = "polach")]
     law: String,
     /// Also print the equivalent conicity (EN 15302 integral method) for amplitudes 1–10 mm.
@@ -93,38 +103,63 @@ pub struct ContactArgs {
 }
 
 pub fn run(args: ContactArgs) -> Result<()> {
-    let law = CreepLaw::parse(&args.law)
-        .ok_or_else(|| anyhow::anyhow!("--law must be polach, fastsim or linear"))?;
     if !(args.load_kn > 0.0 && args.speed_kmh > 0.0 && args.mu > 0.0) {
         bail!("--load-kn, --speed-kmh and --mu must be positive");
     }
-    let geo = args.wheelset.geometry()?;
-    let state = geo.solve(args.y_mm * 1e-3, args.yaw_mrad * 1e-3);
-    let speed = args.speed_kmh / 3.6;
-    let motion = WheelsetMotion {
-        spin: args.spin.unwrap_or(speed / geo.nominal_radius),
-        lateral_velocity: args.lateral_velocity,
-        yaw_rate: args.yaw_rate,
-        yaw: args.yaw_mrad * 1e-3,
-        ..WheelsetMotion::rolling(speed, geo.nominal_radius)
+    let vehicle = match &args.vehicle {
+        Some(p) => Some(railforce::vehicle::Vehicle::load(p)?),
+        None => None,
     };
-    let material = Material::STEEL;
-    let centre = [0.0, state.y, state.z];
+    let (geo, model, mass) = match &vehicle {
+        Some(v) => (
+            v.contact.geometry.clone(),
+            v.contact.model(),
+            0.5 * v.bodies[v.contact.wheelsets[0]].mass,
+        ),
+        None => {
+            let law = CreepLaw::parse(&args.law)
+                .ok_or_else(|| anyhow::anyhow!("--law must be polach, fastsim or linear"))?;
+            let model = ContactModel {
+                material: Material::STEEL,
+                friction: args.mu,
+                law,
+                damping_ratio: 0.05,
+            };
+            (args.wheelset.geometry()?, model, 600.0)
+        }
+    };
+    let table = match &vehicle {
+        Some(v) => v.contact.table().clone(),
+        None => geo.table(
+            railforce::vehicle::ContactSettings::TABLE_RANGE,
+            railforce::vehicle::ContactSettings::TABLE_STEP,
+        ),
+    };
+    let y = args.y_mm * 1e-3;
+    let yaw = args.yaw_mrad * 1e-3;
+    let rigid = table.lookup(y);
+    let speed = args.speed_kmh / 3.6;
+    if speed < CREEP_SPEED_FLOOR {
+        eprintln!(
+            "note: creepages are taken over {CREEP_SPEED_FLOOR} m/s below that speed, as in a run"
+        );
+    }
     println!(
-        "wheelset y {:+.2} mm, yaw {:+.2} mrad → roll {:+.4} mrad, centre height {:.3} mm",
+        "wheelset y {:+.2} mm, yaw {:+.2} mrad → rigid roll {:+.4} mrad (+ {:+.3} given), centre height {:.3} mm",
         args.y_mm,
         args.yaw_mrad,
-        state.roll * 1e3,
-        state.z * 1e3
+        rigid.roll * 1e3,
+        args.extra_roll_mrad,
+        rigid.z * 1e3
     );
     println!(
-        "{:<11} {:>8} {:>8} {:>8} {:>9} {:>8} {:>6} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8}",
+        "{:<11} {:>8} {:>8} {:>9} {:>8} {:>8} {:>6} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8}",
         "wheel",
-        "wheel_y",
-        "rail_y",
+        "approach",
         "track_y",
         "r_roll",
         "angle",
+        "N",
         "a",
         "b",
         "p0",
@@ -137,57 +172,58 @@ pub fn run(args: ContactArgs) -> Result<()> {
         "Q"
     );
     println!(
-        "{:<11} {:>8} {:>8} {:>8} {:>9} {:>8} {:>6} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8}",
-        "", "mm", "mm", "mm", "mm", "deg", "mm", "mm", "MPa", "", "", "1/m", "kN", "kN", "kN", "kN"
+        "{:<11} {:>8} {:>8} {:>9} {:>8} {:>8} {:>6} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8}",
+        "", "um", "mm", "mm", "deg", "kN", "mm", "mm", "MPa", "", "", "1/m", "kN", "kN", "kN", "kN"
     );
-    for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-        let main = state.wheels[k];
-        let load = args.load_kn * 1e3;
-        let (n_main, n_second) = match &state.secondary[k] {
-            Some(sec) => split_load(&main.hertz, &sec.hertz, sec.gap, load, &material),
-            None => (load, 0.0),
-        };
-        let mut contacts = vec![(main, n_main, "")];
-        if let Some(sec) = state.secondary[k] {
-            contacts.push((sec, n_second, " (2nd)"));
-        }
-        for (c, n, tag) in contacts {
-            let f = wheel_force(
-                side, &c, centre, state.roll, &motion, n, args.mu, &material, law,
-            );
-            let name = format!("{}{tag}", if k == 0 { "left" } else { "right" });
+    for side in [Side::Left, Side::Right] {
+        let mut w = WheelOnRail::rolling(side, speed, geo.nominal_radius, 0.0, mass);
+        w.y = y;
+        w.yaw = yaw;
+        w.roll = rigid.roll + args.extra_roll_mrad * 1e-3;
+        w.velocity = [
+            speed * yaw.cos() - args.lateral_velocity * yaw.sin(),
+            speed * yaw.sin() + args.lateral_velocity * yaw.cos(),
+            0.0,
+        ];
+        let spin = args.spin.unwrap_or(speed / geo.nominal_radius);
+        w.angular_velocity = [-spin * yaw.sin(), spin * yaw.cos(), args.yaw_rate];
+        w.height = height_for_load(&table, &model, &w, args.load_kn * 1e3);
+        let f = evaluate(&table, &model, &w);
+        let name = if side == Side::Left { "left" } else { "right" };
+        for (j, p) in f.patches.iter().enumerate() {
+            let Some(p) = p else { continue };
             println!(
-                "{:<11} {:>8.2} {:>8.2} {:>8.1} {:>9.2} {:>8.3} {:>6.2} {:>6.2} {:>7.0} {:>9.2e} {:>9.2e} {:>9.3} {:>8.2} {:>8.2} {:>8.2} {:>8.2}",
-                name,
-                c.wheel_y * 1e3,
-                c.rail_y * 1e3,
-                c.point[1] * 1e3,
-                c.rolling_radius * 1e3,
-                c.angle.to_degrees(),
-                f.ellipse.a * 1e3,
-                f.ellipse.b * 1e3,
-                f.ellipse.p0 * 1e-6,
-                f.creepage.x,
-                f.creepage.y,
-                f.creepage.spin,
-                f.creep.x * 1e-3,
-                f.creep.y * 1e-3,
-                f.force[1] * 1e-3,
-                f.force[2] * 1e-3
+                "{:<11} {:>8.1} {:>8.1} {:>9.2} {:>8.3} {:>8.2} {:>6.2} {:>6.2} {:>7.0} {:>9.2e} {:>9.2e} {:>9.3} {:>8.2} {:>8.2} {:>8.2} {:>8.2}",
+                format!("{name}{}", if j > 0 { " (2nd)" } else { "" }),
+                (rigid.z - w.height) * 1e6,
+                (y + p.point[1]) * 1e3,
+                p.radius * 1e3,
+                p.angle.to_degrees(),
+                p.normal * 1e-3,
+                p.ellipse.a * 1e3,
+                p.ellipse.b * 1e3,
+                p.ellipse.p0 * 1e-6,
+                p.creepage.x,
+                p.creepage.y,
+                p.creepage.spin,
+                p.creep.x * 1e-3,
+                p.creep.y * 1e-3,
+                p.force[1] * 1e-3,
+                p.force[2] * 1e-3
             );
-            if c.gap > 0.0 {
-                println!(
-                    "       second contact {:.3} mm above the first",
-                    c.gap * 1e3
-                );
-            }
         }
+        println!(
+            "{:<11} wheel total Y {:+.2} kN, Q {:.2} kN over {} patch(es)",
+            "",
+            f.force[1] * 1e-3,
+            f.force[2] * 1e-3,
+            f.patches.iter().flatten().count()
+        );
     }
     println!(
-        "wheel_y: on the wheel profile from the tape circle (+ field side); rail_y: from the gauge point (+ field side)"
+        "approach: of the wheelset centre below its rigid height; track_y: load centre of the patch (elastic strip contact, the simulator's)"
     );
     if args.conicity {
-        let table = geo.table(15e-3, 1e-4);
         println!("equivalent conicity (EN 15302 integral method):");
         for amp_mm in [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0] {
             match table.equivalent_conicity(amp_mm * 1e-3) {

@@ -70,7 +70,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         "settle_s": args.settle,
         "integration_step_s": args.dt,
         "sampling_rate_hz": sim.config().output_rate,
-        "anti_alias": format!("4th-order Butterworth low-pass at {} Hz at the integration rate, then decimation", sim.config().cutoff),
+        "anti_alias": format!("8th-order Butterworth low-pass at {} Hz at the integration rate, then decimation", sim.config().cutoff),
         "frame": "track frame: x along the running direction, y to the left, z up",
         "forces": "forces of the rail on the wheel in the track frame: force_y = Y (+ left), force_z = Q (+ up); wheels 1L..4R numbered from the front, left/right facing the running direction",
         "accelerations": vehicle.accelerometers.describe(),

@@ -98,14 +98,14 @@ pub struct ContactState {
 /// Axle direction `a`, lowest-point direction `n` and rolling direction `v` of a yawed and
 /// rolled wheelset.
 #[derive(Debug, Clone, Copy)]
-struct WheelFrame {
+pub(super) struct WheelFrame {
     a: [f64; 3],
     n: [f64; 3],
     v: [f64; 3],
 }
 
 impl WheelFrame {
-    fn new(yaw: f64, roll: f64) -> Self {
+    pub(super) fn new(yaw: f64, roll: f64) -> Self {
         let (sp, cp) = roll.sin_cos();
         let (sy, cy) = yaw.sin_cos();
         let a = [-sy * cp, cy * cp, sp];
@@ -196,7 +196,7 @@ impl WheelsetGeometry {
 
     /// Rail surface height (z up) and slope dz/dy in the track frame at lateral position `yt`.
     #[inline]
-    fn rail_surface(&self, side: Side, yt: f64) -> (f64, f64, f64) {
+    pub(super) fn rail_surface(&self, side: Side, yt: f64) -> (f64, f64, f64) {
         let s = side.sign();
         let ym = s * yt - self.half_gauge;
         let (d, d1, _) = self.rail.eval(ym);
@@ -206,7 +206,7 @@ impl WheelsetGeometry {
     /// Gap, contact point and radius of the wheel circle at profile position `eta`, with the
     /// wheelset centre at height 0.
     #[inline]
-    fn circle_gap(&self, side: Side, y: f64, frame: &WheelFrame, eta: f64) -> (f64, [f64; 3], f64) {
+    pub(super) fn circle_gap(&self, side: Side, y: f64, frame: &WheelFrame, eta: f64) -> (f64, [f64; 3], f64) {
         let s = side.sign();
         let WheelFrame { a, n, v } = *frame;
         let (zw, _, _) = self.wheel.eval(eta);
@@ -432,6 +432,7 @@ impl WheelsetGeometry {
         ContactTable {
             y_min: -(n as f64) * dy,
             dy,
+            strips: super::elastic::StripTable::build(self, &states),
             states,
         }
     }
@@ -443,6 +444,7 @@ pub struct ContactTable {
     y_min: f64,
     dy: f64,
     states: Vec<ContactState>,
+    strips: super::elastic::StripTable,
 }
 
 impl ContactTable {
@@ -459,14 +461,39 @@ impl ContactTable {
         )
     }
 
+    /// The strips of both wheels at every tabulated state (elastic contact).
+    pub fn strips(&self) -> &super::elastic::StripTable {
+        &self.strips
+    }
+
+    /// Height and roll of the rigid solution at grid interval `i`, fraction `t`, and the
+    /// nearer grid point's contact angle and rolling radius of wheel `k` (a cheap part of
+    /// [`ContactTable::lookup`]).
+    #[inline]
+    pub fn rigid(&self, i: usize, t: f64, k: usize) -> (f64, f64, f64, f64) {
+        let (s0, s1) = (&self.states[i], &self.states[i + 1]);
+        let w = if t < 0.5 { &s0.wheels[k] } else { &s1.wheels[k] };
+        (
+            s0.z + t * (s1.z - s0.z),
+            s0.roll + t * (s1.roll - s0.roll),
+            w.angle,
+            w.rolling_radius,
+        )
+    }
+
+    /// Grid interval `i` and fraction `t ∈ [0, 1]` of `y` (clamped to the table).
+    pub fn locate(&self, y: f64) -> (usize, f64) {
+        let (lo, hi) = self.range();
+        let u = ((y.clamp(lo, hi) - self.y_min) / self.dy).min((self.states.len() - 1) as f64);
+        let i = (u as usize).min(self.states.len() - 2);
+        (i, u - i as f64)
+    }
+
     /// Contact state at `y` by linear interpolation between grid points; where a wheel's contact
     /// point jumps (more than 1 mm on the wheel between neighbours), the nearer grid point is
     /// taken for that wheel instead, so a jump to the flange is never smeared.
     pub fn lookup(&self, y: f64) -> ContactState {
-        let (lo, hi) = self.range();
-        let u = ((y.clamp(lo, hi) - self.y_min) / self.dy).min((self.states.len() - 1) as f64);
-        let i = (u as usize).min(self.states.len() - 2);
-        let t = u - i as f64;
+        let (i, t) = self.locate(y);
         let (s0, s1) = (&self.states[i], &self.states[i + 1]);
         let lerp = |a: f64, b: f64| a + t * (b - a);
         let wheel = |k: usize| {

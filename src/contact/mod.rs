@@ -1,6 +1,7 @@
 //! Wheel–rail contact: profiles, contact geometry, Hertz normal contact, creep forces.
 
 pub mod creep;
+pub mod elastic;
 pub mod geometry;
 pub mod hertz;
 pub mod kalker;
@@ -14,5 +15,6 @@ pub use hertz::{HertzEllipse, HertzShape, Material};
 pub use kalker::KalkerCoefficients;
 pub use profile::Profile;
 pub use wheel_rail::{
-    ContactFrame, WheelForce, WheelsetMotion, creepages, split_load, wheel_force,
+    CREEP_SPEED_FLOOR, ContactFrame, ContactModel, PatchForce, WheelForces, WheelOnRail, evaluate,
+    height_for_load,
 };

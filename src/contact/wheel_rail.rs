@@ -1,41 +1,125 @@
-//! One wheel on its rail: creepages from the wheelset's motion, Hertz ellipse, creep forces,
-//! and the resulting force of the rail on the wheel in the track frame.
+//! One wheel on its rail, the single contact evaluation every caller uses (the simulation
+//! step, `railforce contact`, `bench contact`): the elastic strip contact of
+//! [`super::elastic`] gives one or two patches, each gets its normal damping from the
+//! wheel's approach velocity, its creepages from the wheel's motion relative to the rail,
+//! its Hertz ellipse and the creep law; the result is the rail's force and moment on the
+//! wheelset in the track frame.
 
 use super::creep::{CreepContact, CreepForce, CreepLaw, Creepage};
-use super::geometry::{Side, WheelContact};
+use super::geometry::{ContactTable, Side};
 use super::hertz::{HertzEllipse, Material};
 
-/// Motion of a wheelset relative to the track (tangent track frame: x ahead, y left, z up).
+/// Creepages are slip velocities over the running speed; below this speed (m/s) the speed is
+/// held here: creep forces act as dampers of strength `G·a·b·C/V`, which neither creep theory
+/// nor an explicit step follows as V → 0.
+pub const CREEP_SPEED_FLOOR: f64 = 5.0;
+
+/// Contact settings of a vehicle.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WheelsetMotion {
-    /// Forward speed, m/s.
-    pub speed: f64,
-    /// Lateral velocity, m/s.
-    pub lateral_velocity: f64,
-    /// Vertical velocity, m/s.
-    pub vertical_velocity: f64,
-    /// Roll rate, rad/s.
-    pub roll_rate: f64,
-    /// Spin (rotation about the axle, positive when rolling forward), rad/s.
-    pub spin: f64,
-    /// Yaw rate, rad/s.
-    pub yaw_rate: f64,
-    /// Yaw angle, rad.
-    pub yaw: f64,
+pub struct ContactModel {
+    /// Elastic constants.
+    pub material: Material,
+    /// Friction coefficient.
+    pub friction: f64,
+    /// Creep force law.
+    pub law: CreepLaw,
+    /// Damping ratio of the normal contact (of the linearised contact spring with the mass
+    /// behind it).
+    pub damping_ratio: f64,
 }
 
-impl WheelsetMotion {
-    /// Pure rolling at `speed` on wheels of radius `r0`, no other motion.
-    pub fn rolling(speed: f64, r0: f64) -> Self {
-        WheelsetMotion {
-            speed,
-            lateral_velocity: 0.0,
-            vertical_velocity: 0.0,
-            roll_rate: 0.0,
-            spin: speed / r0,
-            yaw_rate: 0.0,
+/// A wheel relative to its rail (track axes: x ahead, y left, z up).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WheelOnRail {
+    /// Which wheel.
+    pub side: Side,
+    /// Lateral shift of the wheelset centre relative to this rail's nominal place (the
+    /// irregularity and the rail's own deflection removed), m.
+    pub y: f64,
+    /// Height of the wheelset centre above this rail's top, m.
+    pub height: f64,
+    /// Roll of the wheelset relative to the rail plane, rad (+ raises the left wheel).
+    pub roll: f64,
+    /// Yaw of the wheelset relative to the track, rad.
+    pub yaw: f64,
+    /// Velocity of the wheelset centre relative to the rail's material, m/s.
+    pub velocity: [f64; 3],
+    /// Angular velocity of the wheelset, rad/s.
+    pub angular_velocity: [f64; 3],
+    /// Lateral and vertical velocity of the rail surface under the moving wheel from the
+    /// irregularity's slope (`V·dy/ds`, `V·dz/ds`), m/s: closes the gap without moving the
+    /// rail's material.
+    pub surface_rate: [f64; 2],
+    /// Running speed (for the creepages), m/s.
+    pub speed: f64,
+    /// Mass behind the contact (half the wheelset), kg.
+    pub mass: f64,
+}
+
+impl WheelOnRail {
+    /// A wheelset rolling at `speed` on wheels of radius `r0`, centred on its rail at
+    /// `height`, no other motion.
+    pub fn rolling(side: Side, speed: f64, r0: f64, height: f64, mass: f64) -> Self {
+        WheelOnRail {
+            side,
+            y: 0.0,
+            height,
+            roll: 0.0,
             yaw: 0.0,
+            velocity: [speed, 0.0, 0.0],
+            angular_velocity: [0.0, speed / r0, 0.0],
+            surface_rate: [0.0; 2],
+            speed,
+            mass,
         }
+    }
+}
+
+/// One contact patch of a wheel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PatchForce {
+    /// Normal load (elastic + damping), N.
+    pub normal: f64,
+    /// Contact angle, rad.
+    pub angle: f64,
+    /// Load centre relative to the wheelset centre, track axes, m.
+    pub point: [f64; 3],
+    /// Rolling radius at the load centre, m.
+    pub radius: f64,
+    /// Hertz ellipse under `normal`.
+    pub ellipse: HertzEllipse,
+    /// Creepages.
+    pub creepage: Creepage,
+    /// Creep forces in the contact plane, N.
+    pub creep: CreepForce,
+    /// Force of the rail on the wheel, track axes, N.
+    pub force: [f64; 3],
+    /// Contact frame.
+    pub frame: ContactFrame,
+}
+
+/// Everything the rail does to one wheel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WheelForces {
+    /// The patches, the larger load first.
+    pub patches: [Option<PatchForce>; 2],
+    /// Total force of the rail on the wheel, track axes, N.
+    pub force: [f64; 3],
+    /// Its moment about the wheelset centre, track axes, N·m.
+    pub moment: [f64; 3],
+    /// Least gap between wheel and rail, m (negative: the deepest penetration).
+    pub gap: f64,
+    /// Contact angle and rolling radius of the rigid contact at this shift (for reports when
+    /// the wheel is lifted).
+    pub rigid_angle: f64,
+    /// See `rigid_angle`.
+    pub rigid_radius: f64,
+}
+
+impl WheelForces {
+    /// The patch with the larger load.
+    pub fn main(&self) -> Option<&PatchForce> {
+        self.patches[0].as_ref()
     }
 }
 
@@ -78,127 +162,130 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-/// Creepages at a contact: the velocity of the wheel's material at the contact point relative
-/// to the (fixed) rail, divided by the speed, in the contact frame; spin is the wheel's angular
-/// velocity about the contact normal over the speed (1/m).
-///
-/// `rel` is the contact point relative to the wheelset centre (track frame), `roll` the
-/// wheelset roll.
-pub fn creepages(m: &WheelsetMotion, frame: &ContactFrame, rel: [f64; 3], roll: f64) -> Creepage {
-    // Angular velocity: yaw rate about z, roll rate about x, spin about the (rolled, yawed)
-    // axle.
-    let (sp, cp) = roll.sin_cos();
-    let (sy, cy) = m.yaw.sin_cos();
-    let axle = [-sy * cp, cy * cp, sp];
-    let omega = [
-        m.roll_rate * cy + m.spin * axle[0],
-        m.roll_rate * sy + m.spin * axle[1],
-        m.yaw_rate + m.spin * axle[2],
-    ];
-    let w = cross(omega, rel);
-    let v = [
-        m.speed + w[0],
-        m.lateral_velocity + w[1],
-        m.vertical_velocity + w[2],
-    ];
-    let speed = m.speed.abs().max(1e-3);
-    Creepage {
-        x: dot(v, frame.tx) / speed,
-        y: dot(v, frame.ty) / speed,
-        spin: dot(omega, frame.n) / speed,
-    }
-}
-
-/// Everything computed at one wheel's contact.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WheelForce {
-    /// Normal load, N.
-    pub normal: f64,
-    /// Hertz ellipse.
-    pub ellipse: HertzEllipse,
-    /// Creepages.
-    pub creepage: Creepage,
-    /// Creep forces in the contact plane, N.
-    pub creep: CreepForce,
-    /// Force of the rail on the wheel in the track frame `[x, Y, Q]`, N.
-    pub force: [f64; 3],
-    /// Contact frame.
-    pub frame: ContactFrame,
-}
-
-/// Evaluates one wheel's contact for a given normal load: Hertz ellipse, creepages, creep law,
-/// and the total force of the rail on the wheel in the track frame.
-#[allow(clippy::too_many_arguments)]
-pub fn wheel_force(
-    side: Side,
-    contact: &WheelContact,
-    centre: [f64; 3],
-    roll: f64,
-    motion: &WheelsetMotion,
-    normal: f64,
-    mu: f64,
-    material: &Material,
-    law: CreepLaw,
-) -> WheelForce {
-    let frame = ContactFrame::new(side, contact.angle, motion.yaw);
-    let ellipse = contact.hertz.ellipse(normal, material);
-    let rel = [
-        contact.point[0] - centre[0],
-        contact.point[1] - centre[1],
-        contact.point[2] - centre[2],
-    ];
-    let creepage = creepages(motion, &frame, rel, roll);
-    let creep = law.force(
-        &CreepContact {
-            a: ellipse.a,
-            b: ellipse.b,
-            normal,
-            mu,
-            shear_modulus: material.shear_modulus(),
-            poisson: material.poisson,
-        },
-        creepage,
-    );
-    let force = std::array::from_fn(|i| {
-        creep.x * frame.tx[i] + creep.y * frame.ty[i] + normal * frame.n[i]
-    });
-    WheelForce {
-        normal,
-        ellipse,
-        creepage,
-        creep,
-        force,
-        frame,
-    }
-}
-
-/// Shares a wheel's load between a main contact and a second one lying `gap` (m) above it: both
-/// bodies approach by δ, the main contact carries `N1(δ)` and the second `N2(δ − gap)` (Hertz,
-/// `N ∝ δ^{3/2}`), with `N1 + N2 = load`. Returns `(N1, N2)`.
-pub fn split_load(
-    main: &super::hertz::HertzShape,
-    second: &super::hertz::HertzShape,
-    gap: f64,
-    load: f64,
-    material: &Material,
-) -> (f64, f64) {
-    let total = |d: f64| {
-        main.load_from_approach(d, material) + second.load_from_approach(d - gap, material)
+/// The one contact evaluation: the rail's forces on one wheel in the state `w`, from the
+/// vehicle's contact table and settings.
+pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> WheelForces {
+    let k = match w.side {
+        Side::Left => 0,
+        Side::Right => 1,
     };
-    let mut hi = main.ellipse(load, material).approach;
-    let mut lo = 0.0;
-    // total(hi) ≥ load since N1(hi) = load; bisection on δ.
-    for _ in 0..100 {
+    let (i, t) = table.locate(w.y);
+    let (z, roll, rigid_angle, rigid_radius) = table.rigid(i, t, k);
+    // Approach of the centre below the rigid height, and roll beyond the table's.
+    let approach = z - w.height;
+    let droll = w.roll - roll;
+    let (loads, gap) = table
+        .strips()
+        .patches(i, t, k, approach, droll, &model.material);
+    let speed = w.speed.abs().max(CREEP_SPEED_FLOOR);
+    let (sy, cy) = w.yaw.sin_cos();
+    let (sr, cr) = droll.sin_cos();
+    let mut patches: [Option<PatchForce>; 2] = [None, None];
+    let (mut force, mut moment) = ([0.0; 3], [0.0; 3]);
+    for (slot, load) in patches.iter_mut().zip(loads) {
+        let Some(l) = load else { continue };
+        // Load centre from the table (zero yaw, table roll), turned by the extra roll and the
+        // yaw so it stays on the spinning wheel (else the spin about a slightly tilted axle
+        // shows up as false longitudinal creepage).
+        let (y1, z1) = (cr * l.y - sr * l.z, sr * l.y + cr * l.z);
+        let point = [-sy * y1, cy * y1, z1];
+        let frame = ContactFrame::new(w.side, l.angle, w.yaw);
+        let vc = {
+            let r = cross(w.angular_velocity, point);
+            [
+                w.velocity[0] + r[0],
+                w.velocity[1] + r[1],
+                w.velocity[2] + r[2],
+            ]
+        };
+        // Normal damping on the approach rate (wheel into rail, the rail surface rising under
+        // it), with the linearised patch stiffness and the mass behind the contact.
+        let rate = -dot(vc, frame.n) + (w.surface_rate[0] * frame.n[1] + w.surface_rate[1] * frame.n[2]);
+        let k_n = l.stiffness / l.angle.cos().max(0.2);
+        let damping = 2.0 * model.damping_ratio * (k_n * w.mass).sqrt();
+        let normal = (l.normal + damping * rate).max(0.0);
+        if normal <= 0.0 {
+            continue;
+        }
+        let creepage = Creepage {
+            x: dot(vc, frame.tx) / speed,
+            y: dot(vc, frame.ty) / speed,
+            spin: dot(w.angular_velocity, frame.n) / speed,
+        };
+        let ellipse = l.hertz.ellipse(normal, &model.material);
+        let creep = model.law.force(
+            &CreepContact {
+                a: ellipse.a,
+                b: ellipse.b,
+                normal,
+                mu: model.friction,
+                shear_modulus: model.material.shear_modulus(),
+                poisson: model.material.poisson,
+            },
+            creepage,
+        );
+        let f: [f64; 3] = std::array::from_fn(|j| {
+            creep.x * frame.tx[j] + creep.y * frame.ty[j] + normal * frame.n[j]
+        });
+        let m = cross(point, f);
+        for j in 0..3 {
+            force[j] += f[j];
+            moment[j] += m[j];
+        }
+        *slot = Some(PatchForce {
+            normal,
+            angle: l.angle,
+            point,
+            radius: l.radius,
+            ellipse,
+            creepage,
+            creep,
+            force: f,
+            frame,
+        });
+    }
+    if let [Some(a), Some(b)] = &patches
+        && b.normal > a.normal
+    {
+        patches.swap(0, 1);
+    }
+    if patches[0].is_none() && patches[1].is_some() {
+        patches.swap(0, 1);
+    }
+    WheelForces {
+        patches,
+        force,
+        moment,
+        gap,
+        rigid_angle,
+        rigid_radius,
+    }
+}
+
+/// The height of the wheelset centre above the rail at which this wheel carries the vertical
+/// load `load` (N) in the state `w` otherwise (bisection on the approach, the same
+/// evaluation as a run; damping plays no part when nothing moves).
+pub fn height_for_load(table: &ContactTable, model: &ContactModel, w: &WheelOnRail, load: f64) -> f64 {
+    let ts = table.lookup(w.y);
+    let q = |approach: f64| {
+        let mut v = *w;
+        v.height = ts.z - approach;
+        evaluate(table, model, &v).force[2]
+    };
+    let (mut lo, mut hi) = (0.0, 1e-4);
+    while q(hi) < load && hi < super::elastic::STRIP_GAP_MAX {
+        lo = hi;
+        hi *= 2.0;
+    }
+    for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
-        if total(mid) > load {
-            hi = mid;
-        } else {
+        if q(mid) < load {
             lo = mid;
+        } else {
+            hi = mid;
         }
     }
-    let d = 0.5 * (lo + hi);
-    let n1 = main.load_from_approach(d, material);
-    (n1, (load - n1).max(0.0))
+    ts.z - 0.5 * (lo + hi)
 }
 
 #[cfg(test)]
@@ -206,7 +293,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn pure_rolling_has_no_creepage_and_frames_are_orthonormal() {
+    fn contact_frames_are_orthonormal() {
         for side in [Side::Left, Side::Right] {
             let f = ContactFrame::new(side, 0.3, 0.01);
             for (p, q) in [(f.tx, f.ty), (f.ty, f.n), (f.tx, f.n)] {
@@ -216,30 +303,5 @@ mod tests {
                 assert!((dot(v, v) - 1.0).abs() < 1e-12);
             }
         }
-        let m = WheelsetMotion::rolling(20.0, 0.42);
-        let frame = ContactFrame::new(Side::Left, 0.0, 0.0);
-        let c = creepages(&m, &frame, [0.0, 0.75, -0.42], 0.0);
-        assert!(c.x.abs() < 1e-12 && c.y.abs() < 1e-12 && c.spin.abs() < 1e-12);
-        // A larger rolling radius makes the wheel's contact point move backward: ξx < 0.
-        let c = creepages(&m, &frame, [0.0, 0.75, -0.43], 0.0);
-        assert!((c.x - (1.0 - 0.43 / 0.42)).abs() < 1e-12);
-        // Lateral velocity gives lateral creepage; a contact angle gives spin −sinδ/r0.
-        let mut m2 = m;
-        m2.lateral_velocity = 0.2;
-        assert!((creepages(&m2, &frame, [0.0, 0.75, -0.42], 0.0).y - 0.01).abs() < 1e-12);
-        let frame = ContactFrame::new(Side::Left, 0.1, 0.0);
-        let c = creepages(&m, &frame, [0.0, 0.75, -0.42], 0.0);
-        assert!((c.spin + (0.1f64).sin() / 0.42).abs() < 1e-12);
-    }
-
-    #[test]
-    fn load_split_between_two_contacts() {
-        let shape = super::super::hertz::HertzShape::from_radii(0.42, f64::INFINITY, 0.3);
-        let m = Material::STEEL;
-        // Equal shapes at zero gap share equally; a large gap leaves all on the main contact.
-        let (a, b) = split_load(&shape, &shape, 0.0, 100e3, &m);
-        assert!((a - 50e3).abs() < 1.0 && (b - 50e3).abs() < 1.0);
-        let (a, b) = split_load(&shape, &shape, 1e-3, 100e3, &m);
-        assert!((a - 100e3).abs() < 1.0 && b < 1.0);
     }
 }

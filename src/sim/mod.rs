@@ -13,14 +13,14 @@
 //! a direct integrator over 11 bodies costs well under a microsecond.
 
 pub mod checks;
-mod filter;
+pub mod filter;
 pub mod output;
 mod track_frame;
 mod wheel_rail;
 
 pub use output::{Recorder, RunSummary};
 pub use track_frame::{TrackFrame, project};
-pub use wheel_rail::WheelResult;
+pub use wheel_rail::{RailState, WheelResult};
 
 use crate::error::{Error, Result};
 use crate::track::Track;
@@ -62,7 +62,7 @@ impl Default for SimConfig {
             settle: 3.0,
             dt: 2e-4,
             output_rate: 200.0,
-            cutoff: 60.0,
+            cutoff: 50.0,
             start: None,
             stop_on_derailment: true,
             nadal_angle: 70f64.to_radians(),
@@ -98,8 +98,10 @@ pub struct Simulation<'a> {
     /// Steps taken, and the step at which all frames were last refreshed.
     step_count: u64,
     frames_step: u64,
-    /// Per wheel: last normal approach (for contact damping) of the main and second contact.
-    last_approach: Vec<[f64; 2]>,
+    /// Per wheel: the rail under it (compliant track), and the wheel's force on it (lateral,
+    /// vertical) in the last step.
+    rails: Vec<RailState>,
+    rail_force: Vec<[f64; 2]>,
     /// Per wheel: how long Y/Q has exceeded the Nadal limit, s.
     over_nadal: Vec<f64>,
     hauling_integral: f64,
@@ -168,12 +170,23 @@ impl<'a> Simulation<'a> {
         let n_wheels = 2 * vehicle.contact.wheelsets.len();
         let static_load = vehicle.mass() * crate::GRAVITY / n_wheels as f64;
         let centred = table.lookup(0.0);
-        let c0 = centred.wheels[0];
-        let approach = c0
-            .hertz
-            .ellipse(static_load, &vehicle.contact.material)
-            .approach;
-        let wheelset_z = centred.z - approach / c0.angle.cos();
+        // The rails sink under the static load on a compliant track; the wheelsets sit at the
+        // height where each wheel carries its share (the run's own contact evaluation).
+        let rail_z0 = track
+            .spec()
+            .rail_support
+            .map_or(0.0, |s| -static_load / s.vertical.stiffness);
+        let ws_mass = vehicle.bodies[vehicle.contact.wheelsets[0]].mass;
+        let rest = crate::contact::WheelOnRail::rolling(
+            crate::contact::Side::Left,
+            cfg.speed,
+            geo.nominal_radius,
+            0.0,
+            0.5 * ws_mass,
+        );
+        let wheelset_z =
+            crate::contact::height_for_load(table, &vehicle.contact.model(), &rest, static_load)
+                + rail_z0;
         let ws_body = &vehicle.bodies[vehicle.contact.wheelsets[0]];
         let dz = wheelset_z - ws_body.position.z;
         let mut states = Vec::with_capacity(vehicle.bodies.len());
@@ -222,7 +235,14 @@ impl<'a> Simulation<'a> {
             wrenches: vec![Wrench::default(); n],
             memory: vec![[0.0; 4]; vehicle.elements.len()],
             body_s,
-            last_approach: vec![[f64::NAN; 2]; n_wheels],
+            rails: vec![
+                RailState {
+                    z: rail_z0,
+                    ..RailState::default()
+                };
+                n_wheels
+            ],
+            rail_force: vec![[0.0, -static_load]; n_wheels],
             over_nadal: vec![0.0; n_wheels],
             hauling_integral: 0.0,
             time: -cfg.settle,
@@ -258,6 +278,13 @@ impl<'a> Simulation<'a> {
     /// Along-track position of each body, m.
     pub fn body_s(&self) -> &[f64] {
         &self.body_s
+    }
+
+    /// Along-track position of the vehicle centre, m: the mean of the wheelsets' positions,
+    /// which are brought up to date every step (the other bodies' only every few).
+    pub fn centre_s(&self) -> f64 {
+        let w = &self.vehicle.contact.wheelsets;
+        w.iter().map(|&b| self.body_s[b]).sum::<f64>() / w.len() as f64
     }
 
     /// Track frame at each body (as of the last step).
@@ -304,6 +331,7 @@ impl<'a> Simulation<'a> {
             }
         }
         self.contact()?;
+        self.move_rails();
         self.haul();
         // Semi-implicit Euler: velocities first, positions with the new velocities.
         for (i, (st, w)) in self.states.iter_mut().zip(&self.wrenches).enumerate() {
@@ -394,14 +422,15 @@ impl<'a> Simulation<'a> {
         let flange = self.flange_height;
         for k in 0..self.wheels.len() {
             let w = &self.wheels[k];
-            let name = wheel_name(k);
+            let name = || wheel_name(k);
             // Climb: how far the wheel has risen on its flange (contact radius above the tape
             // circle) plus any gap; derailed at 90 % of the flange height (the tip is rounded).
             if w.climb > 0.9 * flange || w.y_rel.abs() > 39e-3 {
                 let msg = format!(
-                    "derailment at t = {:.3} s, s = {:.1} m: wheel {name} climbed {:.1} mm of its {:.1} mm flange (lateral shift {:.1} mm relative to its rail)",
+                    "derailment at t = {:.3} s, s = {:.1} m: wheel {} climbed {:.1} mm of its {:.1} mm flange (lateral shift {:.1} mm relative to its rail)",
                     self.time,
                     w.s,
+                    name(),
                     w.climb * 1e3,
                     flange * 1e3,
                     w.y_rel * 1e3
@@ -418,8 +447,10 @@ impl<'a> Simulation<'a> {
             }
             if self.over_nadal[k] > 0.05 {
                 let msg = format!(
-                    "derailment risk at t = {:.3} s, s = {:.1} m: wheel {name} has |Y/Q| above the Nadal limit {limit:.3} for more than 50 ms",
-                    self.time, w.s
+                    "derailment risk at t = {:.3} s, s = {:.1} m: wheel {} has |Y/Q| above the Nadal limit {limit:.3} for more than 50 ms",
+                    self.time,
+                    w.s,
+                    name()
                 );
                 if self.cfg.stop_on_derailment {
                     return Err(Error::Domain(msg));

@@ -47,7 +47,7 @@ pub struct Recorder {
     names: Vec<String>,
     units: Vec<&'static str>,
     lowpass: Lowpass,
-    filter_state: Vec<[f64; 4]>,
+    filter_state: Vec<super::filter::FilterState>,
     every: usize,
     count: usize,
     row: Vec<f64>,
@@ -91,7 +91,7 @@ impl Recorder {
             names,
             units,
             lowpass: Lowpass::new(cfg.cutoff, 1.0 / cfg.dt),
-            filter_state: vec![[0.0; 4]; n],
+            filter_state: vec![[0.0; super::filter::ORDER]; n],
             every,
             count: 0,
             row: vec![0.0; n],
@@ -167,8 +167,7 @@ fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
         k += 1;
     };
     put(sim.time());
-    let s_centre = sim.body_s().iter().sum::<f64>() / sim.body_s().len() as f64;
-    put(s_centre);
+    put(sim.centre_s());
     if let Some(sl) = &v.sensors {
         let ws_pos = v
             .contact

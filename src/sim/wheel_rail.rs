@@ -1,11 +1,10 @@
-//! Wheel–rail contact in the simulation: each wheelset's pose relative to its track frame,
-//! the contact table at the lateral shift relative to each rail (alignment and gauge
-//! irregularities), elastic normal contact from the Hertz approach (cross-level and vertical
-//! irregularities, roll), a second contact point where the table has one, creepages from the
-//! absolute motion, and the creep law.
+//! Wheel–rail contact in the simulation: each wheel's state relative to its rail (the track
+//! frame, the irregularity and, on a compliant track, the rail's own deflection removed) goes
+//! to the one contact evaluation [`crate::contact::evaluate`]; its force acts on the wheelset
+//! and its reaction on the rail masses.
 
 use super::Simulation;
-use crate::contact::{ContactFrame, Creepage, Side, WheelContact};
+use crate::contact::{Creepage, Side, WheelOnRail, evaluate};
 use crate::error::Result;
 use nalgebra::Vector3;
 
@@ -40,125 +39,106 @@ pub struct WheelResult {
     pub rail_slope: f64,
 }
 
+/// The rail under one wheel when the track is compliant: lateral and vertical displacement
+/// from its place (irregularity included) and their rates, track axes.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RailState {
+    /// Lateral displacement, m (+ left).
+    pub y: f64,
+    /// Lateral velocity, m/s.
+    pub vy: f64,
+    /// Vertical displacement, m (+ up).
+    pub z: f64,
+    /// Vertical velocity, m/s.
+    pub vz: f64,
+}
+
 impl Simulation<'_> {
+    /// The state of wheel `k` (0 left, 1 right) of wheelset body `b` relative to its rail, as
+    /// the one contact evaluation ([`crate::contact::evaluate`]) takes it.
+    pub fn wheel_on_rail(&self, b: usize, k: usize) -> WheelOnRail {
+        let st = self.states[b];
+        let f = self.frames[b];
+        let rel = f.to_local(&(st.position - f.origin));
+        let rot_rel = f.axes.transpose() * st.matrix();
+        let axle = rot_rel.column(1);
+        let w = self.vehicle.contact.wheelsets.iter().position(|&x| x == b).unwrap_or(0);
+        let rail = self.rails[2 * w + k];
+        let r = f.rails();
+        let (side, irr_y, irr_z, y_ds, z_ds) = if k == 0 {
+            (Side::Left, r.left_y, r.left_z, r.left_y_ds, r.left_z_ds)
+        } else {
+            (Side::Right, r.right_y, r.right_z, r.right_y_ds, r.right_z_ds)
+        };
+        let v = f.axes.transpose() * st.velocity;
+        let omega = f.axes.transpose() * st.angular_velocity;
+        WheelOnRail {
+            side,
+            y: rel.y - irr_y - rail.y,
+            height: rel.z - irr_z - rail.z,
+            roll: axle.z.asin(),
+            yaw: (-axle.x).atan2(axle.y),
+            velocity: [v.x, v.y - rail.vy, v.z - rail.vz],
+            angular_velocity: [omega.x, omega.y, omega.z],
+            surface_rate: [v.x * y_ds, v.x * z_ds],
+            speed: v.x,
+            mass: 0.5 * self.vehicle.bodies[b].mass,
+        }
+    }
+
     pub(super) fn contact(&mut self) -> Result<()> {
         let v = self.vehicle;
         let cs = &v.contact;
-        let dt = self.cfg.dt;
+        let model = cs.model();
         for (w, &b) in cs.wheelsets.iter().enumerate() {
             let st = self.states[b];
             let f = self.frames[b];
-            let rel = f.to_local(&(st.position - f.origin));
-            let rot_rel = f.axes.transpose() * st.matrix();
-            let axle = rot_rel.column(1);
-            let yaw = (-axle.x).atan2(axle.y);
-            let roll = axle.z.asin();
-            let rails = *f.rails();
-            // Creep forces act as dampers of strength G·ab·C/V: below 5 m/s the explicit step
-            // could not follow them (and creep theory no longer holds), so V is floored there.
-            let speed = st.velocity.dot(&f.axes.column(0)).abs().max(5.0);
-            for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+            for k in 0..2 {
                 let idx = 2 * w + k;
-                let (irr_y, irr_z, irr_slope) = match side {
-                    Side::Left => (rails.left_y, rails.left_z, rails.left_y_ds),
-                    Side::Right => (rails.right_y, rails.right_z, rails.right_y_ds),
-                };
-                let y_k = rel.y - irr_y;
-                let ts = self.table.lookup(y_k);
-                let main = ts.wheels[k];
-                // Vertical approach of the wheel into its rail: the table's rigid height minus
-                // the actual height over this rail, corrected for the roll difference.
-                let yc = main.point[1] - y_k;
-                let dv = (ts.z - (rel.z - irr_z)) - (roll - ts.roll) * yc;
-                let mut contacts: [(Option<WheelContact>, f64); 2] =
-                    [(Some(main), dv), (None, 0.0)];
-                if let Some(sec) = ts.secondary[k] {
-                    contacts[1] = (Some(sec), dv - sec.gap);
-                }
-                let mut total = Vector3::zeros();
-                let mut result = WheelResult {
+                let wr = self.wheel_on_rail(b, k);
+                let out = evaluate(self.table, &model, &wr);
+                let force = f.axes * Vector3::from(out.force);
+                self.wrenches[b].force += force;
+                self.wrenches[b].torque += f.axes * Vector3::from(out.moment);
+                self.rail_force[idx] = [-out.force[1], -out.force[2]];
+                let lift = out.gap.max(0.0);
+                let main = out.main();
+                let rails = f.rails();
+                self.wheels[idx] = WheelResult {
                     s: self.body_s[b],
-                    y_rel: y_k,
-                    angle: main.angle,
-                    lift: (-dv).max(0.0),
-                    climb: main.rolling_radius - cs.geometry.nominal_radius + (-dv).max(0.0),
-                    yaw,
-                    roll,
-                    y_centre: rel.y,
-                    rail_slope: irr_slope,
-                    ..WheelResult::default()
-                };
-                for (j, (c, dvj)) in contacts.into_iter().enumerate() {
-                    let Some(c) = c else { continue };
-                    let approach = dvj * c.angle.cos();
-                    let last = self.last_approach[idx][j];
-                    self.last_approach[idx][j] = approach;
-                    if approach <= 0.0 {
-                        continue;
-                    }
-                    let hertz_n = c.hertz.load_from_approach(approach, &cs.material);
-                    // Damping of the linearised Hertz spring (k = 1.5 N/δ) with half the
-                    // wheelset's mass.
-                    let rate = if last.is_finite() {
-                        (approach - last) / dt
+                    y_rel: wr.y,
+                    y: out.force[1],
+                    q: out.force[2],
+                    normal: main.map_or(0.0, |p| p.normal),
+                    creepage: main.map_or(Creepage::default(), |p| p.creepage),
+                    angle: main.map_or(out.rigid_angle, |p| p.angle),
+                    lift,
+                    climb: main.map_or(out.rigid_radius, |p| p.radius)
+                        - cs.geometry.nominal_radius
+                        + lift,
+                    yaw: wr.yaw,
+                    roll: wr.roll,
+                    y_centre: f.to_local(&(st.position - f.origin)).y,
+                    rail_slope: if k == 0 {
+                        rails.left_y_ds
                     } else {
-                        0.0
-                    };
-                    let k_lin = 1.5 * hertz_n / approach;
-                    let m_half = 0.5 * v.bodies[b].mass;
-                    let damp = 2.0 * cs.damping_ratio * (k_lin * m_half).sqrt();
-                    let normal = (hertz_n + damp * rate).max(0.0);
-                    if normal <= 0.0 {
-                        continue;
-                    }
-                    // Contact point relative to the wheelset centre: the table's point (at the
-                    // table's roll, zero yaw) turned by the actual extra roll and the yaw, so
-                    // it stays consistent with the spinning axle (otherwise the spin about a
-                    // slightly tilted axle shows up as false longitudinal creepage).
-                    let table_rel = Vector3::new(0.0, c.point[1] - y_k, c.point[2] - ts.z);
-                    let turn = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), yaw)
-                        * nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), roll - ts.roll);
-                    let p_rel_track = turn * table_rel;
-                    let p = st.position + f.axes * p_rel_track;
-                    let cf = ContactFrame::new(side, c.angle, yaw);
-                    let (tx, ty, n) = (
-                        f.axes * Vector3::from(cf.tx),
-                        f.axes * Vector3::from(cf.ty),
-                        f.axes * Vector3::from(cf.n),
-                    );
-                    let r = p - st.position;
-                    let vc = st.velocity + st.angular_velocity.cross(&r);
-                    let creepage = Creepage {
-                        x: vc.dot(&tx) / speed,
-                        y: vc.dot(&ty) / speed,
-                        spin: st.angular_velocity.dot(&n) / speed,
-                    };
-                    let ellipse = c.hertz.ellipse(normal, &cs.material);
-                    let creep = cs.law.force(
-                        &crate::contact::CreepContact {
-                            a: ellipse.a,
-                            b: ellipse.b,
-                            normal,
-                            mu: cs.friction,
-                            shear_modulus: cs.material.shear_modulus(),
-                            poisson: cs.material.poisson,
-                        },
-                        creepage,
-                    );
-                    let force = tx * creep.x + ty * creep.y + n * normal;
-                    self.wrenches[b].add_at(force, p, st.position);
-                    total += force;
-                    if j == 0 {
-                        result.normal = normal;
-                        result.creepage = creepage;
-                    }
-                }
-                let local = f.to_local(&total);
-                result.y = local.y;
-                result.q = local.z;
-                self.wheels[idx] = result;
+                        rails.right_y_ds
+                    },
+                };
             }
         }
         Ok(())
+    }
+
+    /// Moves the rail masses one step under the wheels' reactions (compliant track only).
+    pub(super) fn move_rails(&mut self) {
+        let Some(sup) = self.track.spec().rail_support else {
+            return;
+        };
+        let dt = self.cfg.dt;
+        for (r, f) in self.rails.iter_mut().zip(&self.rail_force) {
+            sup.lateral.step(&mut r.y, &mut r.vy, f[0], dt);
+            sup.vertical.step(&mut r.z, &mut r.vz, f[1], dt);
+        }
     }
 }

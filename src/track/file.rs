@@ -27,6 +27,7 @@ struct TrackFile {
     section: Vec<SectionFile>,
     profile: Option<ProfileFile>,
     irregularity: Option<IrregularityFile>,
+    rail_support: Option<super::support::RailSupportFile>,
 }
 
 fn default_rail_spacing() -> f64 {
@@ -122,6 +123,8 @@ pub struct TrackSpec {
     pub profile: VerticalProfile,
     /// Irregularities, if any.
     pub irregularity: Option<IrregularitySpec>,
+    /// Compliant rail support under each wheel (None: rigid rails).
+    pub rail_support: Option<super::support::RailSupport>,
 }
 
 impl TrackSpec {
@@ -340,6 +343,10 @@ impl TrackSpec {
             sections,
             profile,
             irregularity,
+            rail_support: match &raw.rail_support {
+                Some(f) => Some(super::support::RailSupport::from_file(f, path)?),
+                None => None,
+            },
         })
     }
 

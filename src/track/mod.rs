@@ -9,11 +9,13 @@ pub mod check;
 mod file;
 pub mod irregularity;
 pub mod profile;
+pub mod support;
 
 pub use alignment::{Alignment, Section, SectionKind, Turn, cant_deficiency_acceleration};
 pub use file::{MAX_CANT_MM, MAX_GRADIENT_PERMILLE, TrackSpec};
 pub use irregularity::{Channel, FraClass, Irregularities, IrregularitySpec, RailIrregularity};
 pub use profile::{Grade, VerticalProfile};
+pub use support::{RailSupport, Support};
 
 use crate::error::{Error, Result};
 use std::path::Path;

@@ -44,6 +44,16 @@ impl ContactSettings {
     /// Step of the contact table, m.
     pub const TABLE_STEP: f64 = 1e-4;
 
+    /// The settings of the one contact evaluation ([`crate::contact::evaluate`]).
+    pub fn model(&self) -> crate::contact::ContactModel {
+        crate::contact::ContactModel {
+            material: self.material,
+            friction: self.friction,
+            law: self.law,
+            damping_ratio: self.damping_ratio,
+        }
+    }
+
     /// The contact table over ±40 mm every 0.1 mm (built once, on first use).
     pub fn table(&self) -> &crate::contact::ContactTable {
         self.table

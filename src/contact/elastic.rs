@@ -1,0 +1,298 @@
+//! Elastic normal contact by strips: the wheel profile is cut into strips 0.5 mm wide along its
+//! surface (so the steep flange gets as many per millimetre of surface as the tread);
+//! each strip's vertical gap to its rail is tabulated with the contact table (at the table's
+//! rigid height and roll), and in a run the wheel's actual approach gives each strip a
+//! penetration `d_j = δ − φ'·y_j − g_j`. A strip carries `c_j·d_j` per unit width, with `c_j`
+//! chosen so that a parabolic gap (constant curvatures) gives exactly Hertz's `N = K·δ^{3/2}`:
+//! `∫ d ds = (4/3)·√(2R_y)·δ^{3/2}` over the penetrated width, so `c = K/((4/3)·√(2R_y))`
+//! (`R_y = 1/(2B)` the relative lateral radius, `K` Hertz's constant for the strip's
+//! curvatures). This is the semi-Hertzian strip idea of Ayasse and Chollet's STRIPES (2005)
+//! and the virtual penetration of Kik and Piotrowski (1996) without its ε: the load grows
+//! from zero wherever the gap closes, so the contact moves continuously from tread to flange
+//! root to flank, and two separate penetrated zones are two contacts sharing the load
+//! elastically, with no jump in the normal force when either appears or they merge.
+
+use super::geometry::{ContactState, Side, WheelFrame, WheelsetGeometry};
+use super::hertz::{HertzShape, Material};
+
+/// Width of a strip along the wheel profile's surface, m.
+pub const STRIP_WIDTH: f64 = 5e-4;
+/// Each tabulated wheel also keeps the narrower window of strips with a gap below this (m):
+/// while the wheel's approach stays below it, only that window can be penetrated.
+const NARROW_GAP: f64 = 3e-4;
+/// Strips whose gap at the rigid position exceeds this are not tabulated, m (far above any
+/// approach: 0.3 mm vertically is a 100 kN flange contact at 70°).
+pub const STRIP_GAP_MAX: f64 = 1.5e-3;
+
+/// One strip of a wheel at a tabulated lateral shift.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Strip {
+    /// Vertical gap to the rail at the table's rigid position, m (≥ 0).
+    pub gap: f64,
+    /// Contact angle, rad (as [`super::WheelContact::angle`]).
+    pub angle: f64,
+    /// Lateral position of the strip's contact point from the wheelset centre, m.
+    pub y: f64,
+    /// Height of the contact point relative to the wheelset centre, m.
+    pub z: f64,
+    /// Rolling radius, m.
+    pub radius: f64,
+    /// Normal load per metre of vertical penetration over `E/(1 − ν²)`, m (the strip width
+    /// included).
+    pub stiffness: f64,
+    /// Hertz shape from the strip's curvatures (for the creep ellipse).
+    pub hertz: HertzShape,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Window {
+    /// Index of the first strip on the wheel profile grid.
+    first: u32,
+    /// Offset in the flat strip array.
+    offset: u32,
+    /// Number of strips.
+    len: u32,
+    /// Grid indices `[from, to)` of the strips with a gap below [`NARROW_GAP`].
+    narrow: (u32, u32),
+}
+
+/// Centres and widths (across the track) of strips of equal surface length on a wheel
+/// profile.
+fn strip_grid(wheel: &super::profile::Profile) -> Vec<(f64, f64)> {
+    let (lo, hi) = wheel.range();
+    let fine = 1e-5;
+    let n = ((hi - lo) / fine) as usize;
+    let mut grid = Vec::new();
+    let (mut start, mut arc) = (lo, 0.0);
+    for i in 1..=n {
+        let eta = lo + i as f64 * fine;
+        let (_, w1, _) = wheel.eval(eta - 0.5 * fine);
+        arc += fine * (1.0 + w1 * w1).sqrt();
+        if arc >= STRIP_WIDTH || i == n {
+            grid.push((0.5 * (start + eta), eta - start));
+            start = eta;
+            arc = 0.0;
+        }
+    }
+    grid
+}
+
+/// The strips near contact of both wheels at every shift of a contact table.
+#[derive(Debug, Clone, Default)]
+pub struct StripTable {
+    windows: Vec<[Window; 2]>,
+    strips: Vec<Strip>,
+    /// Gap and lateral position of every strip, apart: the hot data of the search.
+    gap_y: Vec<[f64; 2]>,
+}
+
+/// The load of one penetrated zone of a wheel (one contact patch).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PatchLoad {
+    /// Elastic normal load, N.
+    pub normal: f64,
+    /// Normal stiffness `dN/dδ_vertical`, N/m.
+    pub stiffness: f64,
+    /// Load-weighted contact angle, rad.
+    pub angle: f64,
+    /// Load centre from the wheelset centre (lateral, vertical), m.
+    pub y: f64,
+    /// See `y`.
+    pub z: f64,
+    /// Load-weighted rolling radius, m.
+    pub radius: f64,
+    /// Hertz shape at the deepest strip (for the creep ellipse).
+    pub hertz: HertzShape,
+}
+
+impl WheelsetGeometry {
+    /// The strips of one wheel of a solved state whose gap is below [`STRIP_GAP_MAX`]: index
+    /// of the first on the profile grid and the strips.
+    fn strips(
+        &self,
+        state: &ContactState,
+        side: Side,
+        grid: &[(f64, f64)],
+    ) -> (u32, Vec<Strip>) {
+        let frame = WheelFrame::new(state.yaw, state.roll);
+        let unit = Material {
+            young: 1.0,
+            poisson: 0.0,
+        };
+        let s = side.sign();
+        let gaps: Vec<(f64, [f64; 3], f64)> = grid
+            .iter()
+            .map(|&(eta, _)| {
+                let (g, p, r) = self.circle_gap(side, state.y, &frame, eta);
+                ((g + state.z).max(0.0), p, r)
+            })
+            .collect();
+        let Some(first) = gaps.iter().position(|g| g.0 < STRIP_GAP_MAX) else {
+            return (0, Vec::new());
+        };
+        let last = gaps.iter().rposition(|g| g.0 < STRIP_GAP_MAX).unwrap_or(first);
+        let strips = (first..=last)
+            .map(|j| {
+                let (gap, p, r) = gaps[j];
+                let (eta, width) = grid[j];
+                let (_, slope, ym) = self.rail_surface(side, p[1]);
+                let angle = (s * slope).atan();
+                let (_, w1, w2) = self.wheel().eval(eta);
+                let kw = -w2 / (1.0 + w1 * w1).powf(1.5);
+                let kr = self.rail().curvature(ym);
+                let hertz = HertzShape::new(0.5 * angle.cos() / r, 0.5 * (kw + kr));
+                // K of N = K·δ^{3/2} for these curvatures, per unit E/(1 − ν²).
+                let k = hertz.load_from_approach(1e-4, &unit) * 1e6;
+                let r_y = 1.0 / (2.0 * (0.5 * (kw + kr)).max(1e-3));
+                let c = k / (4.0 / 3.0 * (2.0 * r_y).sqrt());
+                Strip {
+                    gap,
+                    angle,
+                    y: p[1] - state.y,
+                    z: p[2],
+                    radius: r,
+                    stiffness: c * width,
+                    hertz,
+                }
+            })
+            .collect();
+        (first as u32, strips)
+    }
+}
+
+impl StripTable {
+    /// Tabulates the strips of both wheels for every state of a contact table.
+    pub(super) fn build(geo: &WheelsetGeometry, states: &[ContactState]) -> Self {
+        let mut table = StripTable::default();
+        let grid = strip_grid(geo.wheel());
+        for st in states {
+            let mut w = [Window::default(); 2];
+            for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+                let (first, strips) = geo.strips(st, side, &grid);
+                let near = |g: &&Strip| g.gap < NARROW_GAP;
+                let from = strips.iter().position(|g| near(&g)).unwrap_or(0);
+                let to = strips.iter().rposition(|g| near(&g)).map_or(0, |i| i + 1);
+                w[k] = Window {
+                    first,
+                    offset: table.strips.len() as u32,
+                    len: strips.len() as u32,
+                    narrow: (first + from as u32, first + to as u32),
+                };
+                table.gap_y.extend(strips.iter().map(|g| [g.gap, g.y]));
+                table.strips.extend(strips);
+            }
+            table.windows.push(w);
+        }
+        table
+    }
+
+    /// Number of strips stored.
+    pub fn len(&self) -> usize {
+        self.strips.len()
+    }
+
+    /// Whether nothing is stored.
+    pub fn is_empty(&self) -> bool {
+        self.strips.is_empty()
+    }
+
+    /// The penetrated zones of wheel `k` (0 left, 1 right) between tabulated states `i` and
+    /// `i + 1` (fraction `t`), for a vertical approach `approach` of the wheelset centre below
+    /// the table's rigid height and a roll `roll` relative to the table's (m, rad). Returns up
+    /// to two patches (the deepest two zones; a third, rare, is added to the nearer) and the
+    /// least gap (negative: the deepest penetration), m.
+    pub fn patches(
+        &self,
+        i: usize,
+        t: f64,
+        k: usize,
+        approach: f64,
+        roll: f64,
+        material: &Material,
+    ) -> ([Option<PatchLoad>; 2], f64) {
+        let e_star = material.young / (1.0 - material.poisson * material.poisson);
+        let (w0, w1) = (self.windows[i][k], self.windows[i + 1][k]);
+        let mut j0 = w0.first.max(w1.first);
+        let mut j1 = (w0.first + w0.len).min(w1.first + w1.len);
+        // Strips outside both narrow windows have gaps above NARROW_GAP at both ends of the
+        // interval: while the deepest possible penetration stays below that, skip them.
+        if approach + roll.abs() * 0.9 < NARROW_GAP {
+            j0 = j0.max(w0.narrow.0.min(w1.narrow.0));
+            j1 = j1.min(w0.narrow.1.max(w1.narrow.1));
+        }
+        let mut out: [Option<PatchLoad>; 2] = [None, None];
+        let mut least = f64::INFINITY;
+        // Running sums of the current zone: N, dN/dδ, N·angle, N·y, N·z, N·r, deepest.
+        let mut acc: Option<([f64; 6], f64, HertzShape)> = None;
+        let close = |acc: &mut Option<([f64; 6], f64, HertzShape)>,
+                         out: &mut [Option<PatchLoad>; 2]| {
+            let Some((a, _, hertz)) = acc.take() else {
+                return;
+            };
+            if a[0] <= 0.0 {
+                return;
+            }
+            let p = PatchLoad {
+                normal: a[0] * e_star,
+                stiffness: a[1] * e_star,
+                angle: a[2] / a[0],
+                y: a[3] / a[0],
+                z: a[4] / a[0],
+                radius: a[5] / a[0],
+                hertz,
+            };
+            if out[0].is_none() {
+                out[0] = Some(p);
+            } else if out[1].is_none() {
+                out[1] = Some(p);
+            } else {
+                // A third zone: fold it into the nearer one.
+                let near = |q: &Option<PatchLoad>| q.map_or(f64::INFINITY, |q| (q.y - p.y).abs());
+                let idx = if near(&out[0]) < near(&out[1]) { 0 } else { 1 };
+                if let Some(q) = out[idx].as_mut() {
+                    let n = q.normal + p.normal;
+                    let mix = |x: f64, y: f64| (x * q.normal + y * p.normal) / n;
+                    q.angle = mix(q.angle, p.angle);
+                    q.y = mix(q.y, p.y);
+                    q.z = mix(q.z, p.z);
+                    q.radius = mix(q.radius, p.radius);
+                    q.normal = n;
+                    q.stiffness += p.stiffness;
+                }
+            }
+        };
+        for j in j0..j1 {
+            let (ia, ib) = (
+                (w0.offset + j - w0.first) as usize,
+                (w1.offset + j - w1.first) as usize,
+            );
+            let ([ga, ya], [gb, yb]) = (self.gap_y[ia], self.gap_y[ib]);
+            let y = ya + t * (yb - ya);
+            let d = approach - roll * y - (ga + t * (gb - ga));
+            least = least.min(-d);
+            if d <= 0.0 {
+                close(&mut acc, &mut out);
+                continue;
+            }
+            let (a, b) = (&self.strips[ia], &self.strips[ib]);
+            let lerp = |x: f64, y: f64| x + t * (y - x);
+            let c = lerp(a.stiffness, b.stiffness);
+            let n = c * d;
+            let z = lerp(a.z, b.z);
+            let (angle, radius) = (lerp(a.angle, b.angle), lerp(a.radius, b.radius));
+            let e = acc.get_or_insert(([0.0; 6], 0.0, a.hertz));
+            e.0[0] += n;
+            e.0[1] += c;
+            e.0[2] += n * angle;
+            e.0[3] += n * y;
+            e.0[4] += n * z;
+            e.0[5] += n * radius;
+            if d > e.1 {
+                e.1 = d;
+                e.2 = if t < 0.5 { a.hertz } else { b.hertz };
+            }
+        }
+        close(&mut acc, &mut out);
+        (out, least)
+    }
+}

@@ -1,0 +1,146 @@
+//! The rail's support under each wheel: a compliant track as lumped "moving" rail masses that
+//! travel with the wheels (as in the track models of multibody codes): per wheel a lateral and
+//! a vertical mass on a spring and a damper to the ground. The vertical mass on its stiffness
+//! with the wheelset's unsprung mass gives Q its P2 resonance; laterally, flange contact meets
+//! the rail head's compliance (lateral bending, fastening and rail roll in series), not a
+//! rigid wall.
+
+use crate::error::{Error, Result};
+use serde::Deserialize;
+use std::path::Path;
+
+/// One direction of the rail support.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Support {
+    /// Effective mass moving with the wheel, kg.
+    pub mass: f64,
+    /// Stiffness to the ground, N/m.
+    pub stiffness: f64,
+    /// Damping to the ground, N·s/m.
+    pub damping: f64,
+}
+
+impl Support {
+    /// Undamped natural frequency of the mass on its spring, Hz.
+    pub fn natural_frequency(&self) -> f64 {
+        (self.stiffness / self.mass).sqrt() / (2.0 * std::f64::consts::PI)
+    }
+
+    /// One semi-implicit Euler step of the mass at displacement `x` and velocity `v` under
+    /// the external force `f` (N) for `dt` (s).
+    #[inline]
+    pub fn step(&self, x: &mut f64, v: &mut f64, f: f64, dt: f64) {
+        *v += (f - self.stiffness * *x - self.damping * *v) / self.mass * dt;
+        *x += *v * dt;
+    }
+}
+
+/// Lateral and vertical support of the rail under each wheel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RailSupport {
+    /// Lateral (at the rail head).
+    pub lateral: Support,
+    /// Vertical.
+    pub vertical: Support,
+}
+
+/// `[rail_support]` in a track file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RailSupportFile {
+    lateral_mass_kg: f64,
+    lateral_stiffness_n_per_m: f64,
+    lateral_damping_ns_per_m: f64,
+    vertical_mass_kg: f64,
+    vertical_stiffness_n_per_m: f64,
+    vertical_damping_ns_per_m: f64,
+}
+
+impl RailSupport {
+    pub(super) fn from_file(f: &RailSupportFile, path: &Path) -> Result<Self> {
+        let check = |field: &str, v: f64, zero_ok: bool| -> Result<f64> {
+            if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) {
+                Ok(v)
+            } else {
+                Err(Error::config(
+                    path,
+                    format!("rail_support.{field}"),
+                    format!(
+                        "must be {}, got {v}",
+                        if zero_ok { "≥ 0" } else { "positive" }
+                    ),
+                ))
+            }
+        };
+        let support = RailSupport {
+            lateral: Support {
+                mass: check("lateral_mass_kg", f.lateral_mass_kg, false)?,
+                stiffness: check("lateral_stiffness_n_per_m", f.lateral_stiffness_n_per_m, false)?,
+                damping: check("lateral_damping_ns_per_m", f.lateral_damping_ns_per_m, true)?,
+            },
+            vertical: Support {
+                mass: check("vertical_mass_kg", f.vertical_mass_kg, false)?,
+                stiffness: check(
+                    "vertical_stiffness_n_per_m",
+                    f.vertical_stiffness_n_per_m,
+                    false,
+                )?,
+                damping: check("vertical_damping_ns_per_m", f.vertical_damping_ns_per_m, true)?,
+            },
+        };
+        // The explicit step must resolve the rail on its own springs with margin.
+        for (name, s) in [("lateral", support.lateral), ("vertical", support.vertical)] {
+            if s.natural_frequency() > 400.0 {
+                return Err(Error::config(
+                    path,
+                    format!("rail_support.{name}_mass_kg"),
+                    format!(
+                        "the {name} rail mass on its spring rings at {:.0} Hz, above the 400 Hz the 0.2 ms step resolves: use more mass or less stiffness",
+                        s.natural_frequency()
+                    ),
+                ));
+            }
+        }
+        Ok(support)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rail mass released from a displacement swings at `√(k/m)/2π` (closed form), counted
+    /// from the zero crossings of the step the simulation uses.
+    #[test]
+    fn rail_mass_rings_at_its_natural_frequency() {
+        let s = Support {
+            mass: 250.0,
+            stiffness: 1e8,
+            damping: 0.0,
+        };
+        let (mut x, mut v, dt) = (1e-3, 0.0, 2e-5);
+        let mut crossings = Vec::new();
+        for i in 0..20_000 {
+            let before = x;
+            s.step(&mut x, &mut v, 0.0, dt);
+            if before > 0.0 && x <= 0.0 {
+                crossings.push(i as f64 * dt);
+            }
+        }
+        let n = crossings.len() - 1;
+        let period = (crossings[n] - crossings[0]) / n as f64;
+        let f = 1.0 / period;
+        assert!((f / s.natural_frequency() - 1.0).abs() < 2e-3, "{f} Hz");
+        assert!((s.natural_frequency() - 100.66).abs() < 0.01);
+        // Static deflection under a load: f/k.
+        let (mut x, mut v) = (0.0, 0.0);
+        let s = Support {
+            damping: 2e5,
+            ..s
+        };
+        for _ in 0..200_000 {
+            s.step(&mut x, &mut v, -1e5, dt);
+        }
+        assert!((x + 1e-3).abs() < 1e-9);
+    }
+}
