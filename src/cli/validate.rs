@@ -46,12 +46,18 @@ enum What {
     },
     /// The simulator's physics checks (spec §6): static wheel loads, quasi-static curving
     /// forces on R 400 m at 60 km/h and R 800 m at 100 km/h, Klingel's wavelength of a free
-    /// wheelset and Wickens' critical speed of a restrained one. Prints measured against
-    /// expected; exits non-zero on a miss.
+    /// wheelset and Wickens' critical speed of a restrained one; then fidelity: the
+    /// anti-alias filter at the output's Nyquist frequency, wheel-force power above 40 Hz in
+    /// the R 400 m curve, convergence in the step (0.2 against 0.05 ms), a smooth s_m, and
+    /// the critical speeds of the loaded and the empty wagon by kink-and-coast. Prints
+    /// measured against expected; exits non-zero on a miss.
     Dynamics {
-        /// Vehicle for the static and curving checks.
+        /// Vehicle for the static, curving and fidelity checks.
         #[arg(long, default_value = "vehicles/c80.toml")]
         vehicle: PathBuf,
+        /// The same wagon empty, for the critical-speed ordering.
+        #[arg(long, default_value = "vehicles/c80_empty.toml")]
+        empty: PathBuf,
         /// Single free wheelset for the Klingel check.
         #[arg(long, default_value = "vehicles/single_wheelset.toml")]
         wheelset: PathBuf,
@@ -73,14 +79,16 @@ pub fn run(args: ValidateArgs) -> Result<()> {
         What::Contact { reference_dir } => contact(&reference_dir),
         What::Dynamics {
             vehicle,
+            empty,
             wheelset,
             restrained,
-        } => dynamics(&vehicle, &wheelset, &restrained),
+        } => dynamics(&vehicle, &empty, &wheelset, &restrained),
     }
 }
 
 fn dynamics(
     vehicle: &std::path::Path,
+    empty: &std::path::Path,
     wheelset: &std::path::Path,
     restrained: &std::path::Path,
 ) -> Result<()> {
@@ -176,10 +184,97 @@ fn dynamics(
         dev * 100.0,
         verdict(dev < 0.05)
     );
+    fidelity(&v, empty, &mut verdict)?;
     if misses > 0 {
         bail!("{misses} check(s) missed");
     }
     println!("all dynamics checks passed");
+    Ok(())
+}
+
+/// The fidelity checks of issue 17: anti-alias, high-frequency force content in a tight
+/// curve, convergence in the step, smooth track position, critical speeds.
+fn fidelity(
+    v: &railforce::vehicle::Vehicle,
+    empty: &std::path::Path,
+    verdict: &mut dyn FnMut(bool) -> &'static str,
+) -> Result<()> {
+    use railforce::sim::{SimConfig, fidelity as fd};
+    let cfg = SimConfig::default();
+    println!("Fidelity:");
+    let db = fd::anti_alias_db(&cfg);
+    println!(
+        "  anti-alias at the {:.0} Hz Nyquist frequency of the {:.0} Hz output: {db:.1} dB (≤ −40 dB)  {}",
+        0.5 * cfg.output_rate,
+        cfg.output_rate,
+        verdict(db <= -40.0)
+    );
+    let track = railforce::track::Track::load(std::path::Path::new("tracks/curve_r400.toml"))?;
+    let (speed, secs) = (60.0 / 3.6, 15.0);
+    let fine = fd::run(v, &track, speed, secs, cfg.dt / 4.0)?;
+    let base = fd::run(v, &track, speed, secs, cfg.dt)?;
+    for name in ["w1l_force_y", "w1l_force_z"] {
+        let share = fd::power_above(&fd::column(&base, name)?, cfg.output_rate, 40.0);
+        println!(
+            "  R 400 m, class 5, 60 km/h: {name} power above 40 Hz {:.2} % of its variance (< 2 %)  {}",
+            share * 100.0,
+            verdict(share < 0.02)
+        );
+    }
+    let n = v.contact.wheelsets.len() * 2;
+    let (a, b) = (fd::yq_and_q(&base, n)?, fd::yq_and_q(&fine, n)?);
+    let worst = |f: fn(&(f64, f64)) -> f64| {
+        a.iter()
+            .zip(&b)
+            .map(|(x, y)| (f(x) / f(y) - 1.0).abs())
+            .fold(0.0f64, f64::max)
+    };
+    let (dyq, dq) = (worst(|p| p.0), worst(|p| p.1));
+    println!(
+        "  step {:.2} ms against {:.3} ms, same run: Y/Q rms within {:.2} %, Q standard deviation within {:.2} % on every wheel (≤ 1 %)  {}",
+        cfg.dt * 1e3,
+        cfg.dt * 250.0,
+        dyq * 100.0,
+        dq * 100.0,
+        verdict(dyq <= 0.01 && dq <= 0.01)
+    );
+    let jitter = fd::position_jitter(&fd::column(&base, "s_m")?);
+    println!(
+        "  s_m advances smoothly: largest second difference {:.3} mm (< 1 mm; a·Δt² is 0.06 mm at 0.5 m/s²)  {}",
+        jitter * 1e3,
+        verdict(jitter < 1e-3)
+    );
+    let smooth = fd::smooth(std::path::Path::new("tracks/tangent.toml"))?;
+    let e = railforce::vehicle::Vehicle::load(empty)?;
+    let (from, to) = (150.0 / 3.6, 50.0 / 3.6);
+    let mut found = Vec::new();
+    for w in [v, &e] {
+        let c = fd::critical_speed(w, &smooth, from, to, 1.0)?;
+        match c.critical {
+            Some(s) => println!(
+                "  kink-and-coast from {:.0} km/h on smooth tangent, {}: hunting dies out at {:.0} km/h",
+                from * 3.6,
+                w.name,
+                s * 3.6
+            ),
+            None => println!(
+                "  kink-and-coast from {:.0} km/h on smooth tangent, {}: no hunting at {:.0} km/h",
+                from * 3.6,
+                w.name,
+                from * 3.6
+            ),
+        }
+        if std::env::var_os("RAILFORCE_VERBOSE").is_some() {
+            for (v, a) in &c.blocks {
+                eprintln!("    {:.0} km/h: {:.2} mm", v * 3.6, a * 1e3);
+            }
+        }
+        found.push(c.critical.unwrap_or(f64::INFINITY));
+    }
+    println!(
+        "  the empty wagon hunts first (critical speed below the loaded one's)  {}",
+        verdict(found[1] < found[0])
+    );
     Ok(())
 }
 

@@ -13,6 +13,7 @@
 //! a direct integrator over 11 bodies costs well under a microsecond.
 
 pub mod checks;
+pub mod fidelity;
 pub mod filter;
 pub mod output;
 mod track_frame;
@@ -263,6 +264,11 @@ impl<'a> Simulation<'a> {
     /// Simulated time, s (negative while settling).
     pub fn time(&self) -> f64 {
         self.time
+    }
+
+    /// Changes the running speed the hauling control holds, m/s (coasting tests).
+    pub fn set_speed(&mut self, speed: f64) {
+        self.cfg.speed = speed;
     }
 
     /// Settings.

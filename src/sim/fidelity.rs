@@ -1,0 +1,160 @@
+//! Checks of the simulator's fidelity beyond the closed forms of [`super::checks`] (issue 17):
+//! the critical speed by kink-and-coast, the high-frequency content of the wheel forces in a
+//! tight curve, convergence in the step, the anti-alias filter at the output's Nyquist
+//! frequency and the smoothness of the recorded track position.
+
+use super::filter::Lowpass;
+use super::output::{Recording, record};
+use super::{SimConfig, Simulation};
+use crate::dsp::welch::welch_psd;
+use crate::error::{Error, Result};
+use crate::track::{Track, TrackSpec};
+use crate::vehicle::Vehicle;
+use std::path::Path;
+
+/// A smooth (irregularity-free) version of a track file, for stability runs.
+pub fn smooth(path: &Path) -> Result<Track> {
+    let mut spec = TrackSpec::load(path)?;
+    spec.irregularity = None;
+    Ok(Track::new(spec, None))
+}
+
+/// Kink-and-coast: the vehicle starts 6 mm off the centre line (a kink) at `from` (m/s),
+/// holds that speed 5 s, then slows at `decel` (m/s²) to `to`. Any hunting limit cycle of the
+/// leading wheelset dies out at the critical speed.
+#[derive(Debug, Clone)]
+pub struct CriticalSpeed {
+    /// Lowest speed at which the limit cycle (half peak-to-peak ≥ 1.5 mm over a 1 s block)
+    /// was still present, m/s; `None` if the wagon was stable already at `from`.
+    pub critical: Option<f64>,
+    /// Speed and half peak-to-peak lateral amplitude of the leading wheelset per 1 s block.
+    pub blocks: Vec<(f64, f64)>,
+}
+
+/// Runs the kink-and-coast test of `vehicle` on the smooth `track`.
+pub fn critical_speed(
+    vehicle: &Vehicle,
+    track: &Track,
+    from: f64,
+    to: f64,
+    decel: f64,
+) -> Result<CriticalSpeed> {
+    let hold = 5.0;
+    let duration = hold + (from - to) / decel + 2.0;
+    let cfg = SimConfig {
+        speed: from,
+        duration,
+        settle: 0.0,
+        initial_offset: 6e-3,
+        stop_on_derailment: true,
+        ..SimConfig::default()
+    };
+    let mut sim = Simulation::new(vehicle, track, cfg)?;
+    let lead = 0;
+    let steps_per_block = (1.0 / sim.config().dt).round() as usize;
+    let mut blocks = Vec::new();
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut n = 0;
+    while sim.time() < duration {
+        let t = sim.time();
+        let v = if t < hold {
+            from
+        } else {
+            (from - decel * (t - hold)).max(to)
+        };
+        sim.set_speed(v);
+        sim.step()?;
+        let y = sim.wheels[2 * lead].y_centre;
+        lo = lo.min(y);
+        hi = hi.max(y);
+        n += 1;
+        if n == steps_per_block {
+            blocks.push((v, 0.5 * (hi - lo)));
+            (lo, hi, n) = (f64::INFINITY, f64::NEG_INFINITY, 0);
+        }
+    }
+    // Skip the first 2 s (the kink's own transient).
+    let hunting = |a: f64| a >= 1.5e-3;
+    let critical = blocks
+        .iter()
+        .skip(2)
+        .take_while(|b| hunting(b.1))
+        .last()
+        .map(|b| b.0);
+    Ok(CriticalSpeed { critical, blocks })
+}
+
+/// Share of a signal's variance above `f` (Hz), by Welch's periodogram of the recorded signal
+/// at `rate` (Hz).
+pub fn power_above(x: &[f64], rate: f64, f: f64) -> f64 {
+    let p = welch_psd(x, 1.0 / rate, 512);
+    let total: f64 = p.density.iter().skip(1).sum();
+    let high: f64 = p
+        .freq
+        .iter()
+        .zip(&p.density)
+        .filter(|(fr, _)| **fr > f)
+        .map(|(_, d)| d)
+        .sum();
+    if total > 0.0 { high / total } else { 0.0 }
+}
+
+/// Records `vehicle` on `track` at `speed` for `duration` seconds with step `dt`.
+pub fn run(
+    vehicle: &Vehicle,
+    track: &Track,
+    speed: f64,
+    duration: f64,
+    dt: f64,
+) -> Result<Recording> {
+    let cfg = SimConfig {
+        speed,
+        duration,
+        dt,
+        ..SimConfig::default()
+    };
+    let mut sim = Simulation::new(vehicle, track, cfg)?;
+    record(&mut sim, |_| {})
+}
+
+/// A column of a recording by name.
+pub fn column(rec: &Recording, name: &str) -> Result<Vec<f64>> {
+    let i = rec
+        .names
+        .iter()
+        .position(|n| n == name)
+        .ok_or_else(|| Error::Domain(format!("no channel '{name}' in the recording")))?;
+    Ok(rec.column(i))
+}
+
+/// RMS of |Y/Q| and standard deviation of Q of every wheel of a recording.
+pub fn yq_and_q(rec: &Recording, wheels: usize) -> Result<Vec<(f64, f64)>> {
+    (0..wheels)
+        .map(|k| {
+            let name = crate::vehicle::wheel_name(k).to_lowercase();
+            let y = column(rec, &format!("w{name}_force_y"))?;
+            let q = column(rec, &format!("w{name}_force_z"))?;
+            let n = y.len() as f64;
+            let yq = (y.iter().zip(&q).map(|(a, b)| (a / b).powi(2)).sum::<f64>() / n).sqrt();
+            let mean = q.iter().sum::<f64>() / n;
+            let sd = (q.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+            Ok((yq, sd))
+        })
+        .collect()
+}
+
+/// Attenuation of the default anti-alias filter at the output's Nyquist frequency, dB
+/// (negative).
+pub fn anti_alias_db(cfg: &SimConfig) -> f64 {
+    let lp = Lowpass::new(cfg.cutoff, 1.0 / cfg.dt);
+    20.0 * lp.gain(0.5 * cfg.output_rate).log10()
+}
+
+/// Largest second difference of the recorded track position, m: `|s[i+1] − 2·s[i] + s[i−1]|`
+/// is `a·Δt²` for a smooth motion (0.06 mm at 0.5 m/s² and 200 Hz), while a position refreshed
+/// only every few steps jumps by centimetres.
+pub fn position_jitter(s: &[f64]) -> f64 {
+    s.windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+        .fold(0.0, f64::max)
+}
