@@ -101,39 +101,65 @@ pub struct PatchLoad {
     pub z: f64,
     /// Load-weighted rolling radius, m.
     pub radius: f64,
-    /// Hertz shape at the deepest strip (for the creep ellipse).
+    /// Load-weighted Hertz shape of the strips (for the creep ellipse; weighted so that it
+    /// changes continuously as the patch moves over the profile's curvatures).
     pub hertz: HertzShape,
 }
 
 impl WheelsetGeometry {
     /// The strips of one wheel of a solved state whose gap is below [`STRIP_GAP_MAX`]: index
     /// of the first on the profile grid and the strips.
+    /// Gaps of one wheel of a solved state at every strip of the grid.
+    fn strip_gaps(
+        &self,
+        state: &ContactState,
+        side: Side,
+        grid: &[(f64, f64)],
+    ) -> Vec<(f64, [f64; 3], f64)> {
+        let frame = WheelFrame::new(state.yaw, state.roll);
+        grid.iter()
+            .map(|&(eta, _)| {
+                let (g, p, r) = self.circle_gap(side, state.y, &frame, eta);
+                ((g + state.z).max(0.0), p, r)
+            })
+            .collect()
+    }
+
+    /// Grid range of the strips of one wheel of a solved state whose gap is below
+    /// [`STRIP_GAP_MAX`] (empty: `(0, 0)`).
+    fn strip_range(&self, state: &ContactState, side: Side, grid: &[(f64, f64)]) -> (usize, usize) {
+        let gaps = self.strip_gaps(state, side, grid);
+        match gaps.iter().position(|g| g.0 < STRIP_GAP_MAX) {
+            None => (0, 0),
+            Some(first) => (
+                first,
+                gaps.iter().rposition(|g| g.0 < STRIP_GAP_MAX).unwrap_or(first) + 1,
+            ),
+        }
+    }
+
+    /// The strips `range` of one wheel of a solved state.
     fn strips(
         &self,
         state: &ContactState,
         side: Side,
         grid: &[(f64, f64)],
-    ) -> (u32, Vec<Strip>) {
-        let frame = WheelFrame::new(state.yaw, state.roll);
+        range: (usize, usize),
+    ) -> Vec<Strip> {
         let unit = Material {
             young: 1.0,
             poisson: 0.0,
         };
         let s = side.sign();
-        let gaps: Vec<(f64, [f64; 3], f64)> = grid
-            .iter()
-            .map(|&(eta, _)| {
-                let (g, p, r) = self.circle_gap(side, state.y, &frame, eta);
-                ((g + state.z).max(0.0), p, r)
-            })
-            .collect();
-        let Some(first) = gaps.iter().position(|g| g.0 < STRIP_GAP_MAX) else {
-            return (0, Vec::new());
-        };
-        let last = gaps.iter().rposition(|g| g.0 < STRIP_GAP_MAX).unwrap_or(first);
-        let strips = (first..=last)
+        if range.1 <= range.0 {
+            return Vec::new();
+        }
+        let gaps = self.strip_gaps(state, side, &grid[range.0..range.1]);
+        let first = range.0;
+        let last = range.1 - 1;
+        (first..=last)
             .map(|j| {
-                let (gap, p, r) = gaps[j];
+                let (gap, p, r) = gaps[j - first];
                 let (eta, width) = grid[j];
                 let (_, slope, ym) = self.rail_surface(side, p[1]);
                 let angle = (s * slope).atan();
@@ -155,8 +181,7 @@ impl WheelsetGeometry {
                     hertz,
                 }
             })
-            .collect();
-        (first as u32, strips)
+            .collect()
     }
 }
 
@@ -165,10 +190,31 @@ impl StripTable {
     pub(super) fn build(geo: &WheelsetGeometry, states: &[ContactState]) -> Self {
         let mut table = StripTable::default();
         let grid = strip_grid(geo.wheel());
-        for st in states {
+        let sides = [Side::Left, Side::Right];
+        let ranges: Vec<[(usize, usize); 2]> = states
+            .iter()
+            .map(|st| sides.map(|side| geo.strip_range(st, side, &grid)))
+            .collect();
+        for (i, st) in states.iter().enumerate() {
             let mut w = [Window::default(); 2];
-            for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-                let (first, strips) = geo.strips(st, side, &grid);
+            for (k, side) in sides.into_iter().enumerate() {
+                // Each state also keeps the strips its neighbours keep: on a steep flank a
+                // strip's gap changes by a millimetre between grid points, and an interval
+                // must see every strip that is near contact at either of its ends.
+                let mut range = ranges[i][k];
+                for n in [i.wrapping_sub(1), i + 1] {
+                    if let Some(r) = ranges.get(n).map(|r| r[k])
+                        && r.1 > r.0
+                    {
+                        range = if range.1 > range.0 {
+                            (range.0.min(r.0), range.1.max(r.1))
+                        } else {
+                            r
+                        };
+                    }
+                }
+                let strips = geo.strips(st, side, &grid, range);
+                let first = range.0 as u32;
                 let near = |g: &&Strip| g.gap < NARROW_GAP;
                 let from = strips.iter().position(|g| near(&g)).unwrap_or(0);
                 let to = strips.iter().rposition(|g| near(&g)).map_or(0, |i| i + 1);
@@ -222,16 +268,22 @@ impl StripTable {
         }
         let mut out: [Option<PatchLoad>; 2] = [None, None];
         let mut least = f64::INFINITY;
-        // Running sums of the current zone: N, dN/dδ, N·angle, N·y, N·z, N·r, deepest.
-        let mut acc: Option<([f64; 6], f64, HertzShape)> = None;
-        let close = |acc: &mut Option<([f64; 6], f64, HertzShape)>,
-                         out: &mut [Option<PatchLoad>; 2]| {
-            let Some((a, _, hertz)) = acc.take() else {
+        // Running sums of the current zone: N, dN/dδ, N·angle, N·y, N·z, N·r, and N times the
+        // Hertz shape's four numbers.
+        let mut acc: Option<[f64; 10]> = None;
+        let close = |acc: &mut Option<[f64; 10]>, out: &mut [Option<PatchLoad>; 2]| {
+            let Some(a) = acc.take() else {
                 return;
             };
             if a[0] <= 0.0 {
                 return;
             }
+            let hertz = HertzShape {
+                curvature_sum: a[6] / a[0],
+                ma: a[7] / a[0],
+                mb: a[8] / a[0],
+                k_over_e: a[9] / a[0],
+            };
             let p = PatchLoad {
                 normal: a[0] * e_star,
                 stiffness: a[1] * e_star,
@@ -280,17 +332,18 @@ impl StripTable {
             let n = c * d;
             let z = lerp(a.z, b.z);
             let (angle, radius) = (lerp(a.angle, b.angle), lerp(a.radius, b.radius));
-            let e = acc.get_or_insert(([0.0; 6], 0.0, a.hertz));
-            e.0[0] += n;
-            e.0[1] += c;
-            e.0[2] += n * angle;
-            e.0[3] += n * y;
-            e.0[4] += n * z;
-            e.0[5] += n * radius;
-            if d > e.1 {
-                e.1 = d;
-                e.2 = if t < 0.5 { a.hertz } else { b.hertz };
-            }
+            let e = acc.get_or_insert([0.0; 10]);
+            let (ha, hb) = (&a.hertz, &b.hertz);
+            e[0] += n;
+            e[1] += c;
+            e[2] += n * angle;
+            e[3] += n * y;
+            e[4] += n * z;
+            e[5] += n * radius;
+            e[6] += n * lerp(ha.curvature_sum, hb.curvature_sum);
+            e[7] += n * lerp(ha.ma, hb.ma);
+            e[8] += n * lerp(ha.mb, hb.mb);
+            e[9] += n * lerp(ha.k_over_e, hb.k_over_e);
         }
         close(&mut acc, &mut out);
         (out, least)

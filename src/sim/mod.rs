@@ -103,6 +103,8 @@ pub struct Simulation<'a> {
     /// vertical) in the last step.
     rails: Vec<RailState>,
     rail_force: Vec<[f64; 2]>,
+    /// Per wheel: the state the last contact evaluation was given.
+    inputs: Vec<crate::contact::WheelOnRail>,
     /// Per wheel: how long Y/Q has exceeded the Nadal limit, s.
     over_nadal: Vec<f64>,
     hauling_integral: f64,
@@ -244,6 +246,7 @@ impl<'a> Simulation<'a> {
                 n_wheels
             ],
             rail_force: vec![[0.0, -static_load]; n_wheels],
+            inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
             hauling_integral: 0.0,
             time: -cfg.settle,

@@ -54,6 +54,11 @@ pub struct RailState {
 }
 
 impl Simulation<'_> {
+    /// What the last step gave the contact evaluation for each wheel (1L, 1R, 2L, …).
+    pub fn contact_inputs(&self) -> &[WheelOnRail] {
+        &self.inputs
+    }
+
     /// The state of wheel `k` (0 left, 1 right) of wheelset body `b` relative to its rail, as
     /// the one contact evaluation ([`crate::contact::evaluate`]) takes it.
     pub fn wheel_on_rail(&self, b: usize, k: usize) -> WheelOnRail {
@@ -97,6 +102,7 @@ impl Simulation<'_> {
                 let idx = 2 * w + k;
                 let wr = self.wheel_on_rail(b, k);
                 let out = evaluate(self.table, &model, &wr);
+                self.inputs[idx] = wr;
                 let force = f.axes * Vector3::from(out.force);
                 self.wrenches[b].force += force;
                 self.wrenches[b].torque += f.axes * Vector3::from(out.moment);
