@@ -188,7 +188,11 @@ fn run_cli_and_library_compute_the_same_contact() {
     }
     let b = v.contact.wheelsets[0];
     for k in 0..8 {
-        let expected = evaluate(v.contact.table(), &v.contact.model(), &sim.contact_inputs()[k]);
+        let expected = evaluate(
+            v.contact.table(),
+            &v.contact.model(),
+            &sim.contact_inputs()[k],
+        );
         assert_eq!(sim.wheels[k].y, expected.force[1]);
         assert_eq!(sim.wheels[k].q, expected.force[2]);
     }
@@ -200,7 +204,11 @@ fn run_cli_and_library_compute_the_same_contact() {
         .args(["--y-mm", "4", "--load-kn", "122.6", "--speed-kmh", "60"])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
     let line = text
         .lines()
@@ -227,7 +235,11 @@ fn run_cli_and_library_compute_the_same_contact() {
     w.roll = table.lookup(4e-3).roll;
     w.height = height_for_load(table, &model, &w, 122.6e3);
     let f = evaluate(table, &model, &w);
-    assert!((y_cli - f.force[1] * 1e-3).abs() < 0.006, "{y_cli} vs {}", f.force[1]);
+    assert!(
+        (y_cli - f.force[1] * 1e-3).abs() < 0.006,
+        "{y_cli} vs {}",
+        f.force[1]
+    );
 }
 
 /// The empty wagon's file is the loaded one's but for its name and URDF (kept in step).

@@ -33,10 +33,7 @@ pub fn run(vehicle: &Vehicle, iterations: usize) -> ContactBench {
     base.angular_velocity[2] = 0.01;
     base.yaw = 1e-3;
     let time_wheel = |law: CreepLaw, n: usize| {
-        let model = crate::contact::ContactModel {
-            law,
-            ..cs.model()
-        };
+        let model = crate::contact::ContactModel { law, ..cs.model() };
         // Heights that carry the load, every 0.12 mm of shift (not timed).
         let heights: Vec<f64> = (0..100)
             .map(|i| {

@@ -133,7 +133,10 @@ impl WheelsetGeometry {
             None => (0, 0),
             Some(first) => (
                 first,
-                gaps.iter().rposition(|g| g.0 < STRIP_GAP_MAX).unwrap_or(first) + 1,
+                gaps.iter()
+                    .rposition(|g| g.0 < STRIP_GAP_MAX)
+                    .unwrap_or(first)
+                    + 1,
             ),
         }
     }

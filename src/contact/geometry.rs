@@ -206,7 +206,13 @@ impl WheelsetGeometry {
     /// Gap, contact point and radius of the wheel circle at profile position `eta`, with the
     /// wheelset centre at height 0.
     #[inline]
-    pub(super) fn circle_gap(&self, side: Side, y: f64, frame: &WheelFrame, eta: f64) -> (f64, [f64; 3], f64) {
+    pub(super) fn circle_gap(
+        &self,
+        side: Side,
+        y: f64,
+        frame: &WheelFrame,
+        eta: f64,
+    ) -> (f64, [f64; 3], f64) {
         let s = side.sign();
         let WheelFrame { a, n, v } = *frame;
         let (zw, _, _) = self.wheel.eval(eta);
@@ -472,7 +478,11 @@ impl ContactTable {
     #[inline]
     pub fn rigid(&self, i: usize, t: f64, k: usize) -> (f64, f64, f64, f64) {
         let (s0, s1) = (&self.states[i], &self.states[i + 1]);
-        let w = if t < 0.5 { &s0.wheels[k] } else { &s1.wheels[k] };
+        let w = if t < 0.5 {
+            &s0.wheels[k]
+        } else {
+            &s1.wheels[k]
+        };
         (
             s0.z + t * (s1.z - s0.z),
             s0.roll + t * (s1.roll - s0.roll),

@@ -200,7 +200,8 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
         };
         // Normal damping on the approach rate (wheel into rail, the rail surface rising under
         // it), with the linearised patch stiffness and the mass behind the contact.
-        let rate = -dot(vc, frame.n) + (w.surface_rate[0] * frame.n[1] + w.surface_rate[1] * frame.n[2]);
+        let rate =
+            -dot(vc, frame.n) + (w.surface_rate[0] * frame.n[1] + w.surface_rate[1] * frame.n[2]);
         let k_n = l.stiffness / l.angle.cos().max(0.2);
         let damping = 2.0 * model.damping_ratio * (k_n * w.mass).sqrt();
         let normal = (l.normal + damping * rate).max(0.0);
@@ -265,7 +266,12 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
 /// The height of the wheelset centre above the rail at which this wheel carries the vertical
 /// load `load` (N) in the state `w` otherwise (bisection on the approach, the same
 /// evaluation as a run; damping plays no part when nothing moves).
-pub fn height_for_load(table: &ContactTable, model: &ContactModel, w: &WheelOnRail, load: f64) -> f64 {
+pub fn height_for_load(
+    table: &ContactTable,
+    model: &ContactModel,
+    w: &WheelOnRail,
+    load: f64,
+) -> f64 {
     let ts = table.lookup(w.y);
     let q = |approach: f64| {
         let mut v = *w;

@@ -67,13 +67,25 @@ impl Simulation<'_> {
         let rel = f.to_local(&(st.position - f.origin));
         let rot_rel = f.axes.transpose() * st.matrix();
         let axle = rot_rel.column(1);
-        let w = self.vehicle.contact.wheelsets.iter().position(|&x| x == b).unwrap_or(0);
+        let w = self
+            .vehicle
+            .contact
+            .wheelsets
+            .iter()
+            .position(|&x| x == b)
+            .unwrap_or(0);
         let rail = self.rails[2 * w + k];
         let r = f.rails();
         let (side, irr_y, irr_z, y_ds, z_ds) = if k == 0 {
             (Side::Left, r.left_y, r.left_z, r.left_y_ds, r.left_z_ds)
         } else {
-            (Side::Right, r.right_y, r.right_z, r.right_y_ds, r.right_z_ds)
+            (
+                Side::Right,
+                r.right_y,
+                r.right_z,
+                r.right_y_ds,
+                r.right_z_ds,
+            )
         };
         let v = f.axes.transpose() * st.velocity;
         let omega = f.axes.transpose() * st.angular_velocity;
@@ -119,8 +131,7 @@ impl Simulation<'_> {
                     creepage: main.map_or(Creepage::default(), |p| p.creepage),
                     angle: main.map_or(out.rigid_angle, |p| p.angle),
                     lift,
-                    climb: main.map_or(out.rigid_radius, |p| p.radius)
-                        - cs.geometry.nominal_radius
+                    climb: main.map_or(out.rigid_radius, |p| p.radius) - cs.geometry.nominal_radius
                         + lift,
                     yaw: wr.yaw,
                     roll: wr.roll,

@@ -75,7 +75,11 @@ impl RailSupport {
         let support = RailSupport {
             lateral: Support {
                 mass: check("lateral_mass_kg", f.lateral_mass_kg, false)?,
-                stiffness: check("lateral_stiffness_n_per_m", f.lateral_stiffness_n_per_m, false)?,
+                stiffness: check(
+                    "lateral_stiffness_n_per_m",
+                    f.lateral_stiffness_n_per_m,
+                    false,
+                )?,
                 damping: check("lateral_damping_ns_per_m", f.lateral_damping_ns_per_m, true)?,
             },
             vertical: Support {
@@ -85,7 +89,11 @@ impl RailSupport {
                     f.vertical_stiffness_n_per_m,
                     false,
                 )?,
-                damping: check("vertical_damping_ns_per_m", f.vertical_damping_ns_per_m, true)?,
+                damping: check(
+                    "vertical_damping_ns_per_m",
+                    f.vertical_damping_ns_per_m,
+                    true,
+                )?,
             },
         };
         // The explicit step must resolve the rail on its own springs with margin.
@@ -134,10 +142,7 @@ mod tests {
         assert!((s.natural_frequency() - 100.66).abs() < 0.01);
         // Static deflection under a load: f/k.
         let (mut x, mut v) = (0.0, 0.0);
-        let s = Support {
-            damping: 2e5,
-            ..s
-        };
+        let s = Support { damping: 2e5, ..s };
         for _ in 0..200_000 {
             s.step(&mut x, &mut v, -1e5, dt);
         }

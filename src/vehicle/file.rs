@@ -88,7 +88,6 @@ struct SensorsFile {
     label_wheel: String,
 }
 
-
 fn b_find(
     path: &Path,
     urdf: &Path,

@@ -2,9 +2,9 @@
 //! the sensor layout from a TOML file beside it (urdf-rs drops unknown XML, so suspension data
 //! does not live in the URDF).
 
+mod binder;
 pub mod body;
 pub mod elements;
-mod binder;
 mod file;
 mod urdf;
 mod wheel;

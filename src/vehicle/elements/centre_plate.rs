@@ -6,10 +6,10 @@
 //! gravity and supported below it is an inverted pendulum.
 
 use super::Relative;
-use crate::vehicle::body::{Attachment, BodyState, Wrench};
-use nalgebra::Vector3;
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
+use crate::vehicle::body::{Attachment, BodyState, Wrench};
+use nalgebra::Vector3;
 use serde::Deserialize;
 
 /// Centre plate between the carbody (upper) and a bolster (lower).

@@ -4,10 +4,10 @@
 //! axes of their mean yaw; energy `½·k·γ²`, applied as the matching pair of longitudinal forces
 //! and yaw torques (no net force, no net moment).
 
-use crate::vehicle::body::{BodyState, Wrench};
-use nalgebra::Vector3;
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
+use crate::vehicle::body::{BodyState, Wrench};
+use nalgebra::Vector3;
 use serde::Deserialize;
 
 /// Cross-bracing between the left and right side frames of one bogie.

@@ -1,10 +1,10 @@
 //! Axle-box rubber shear pad: linear spring–damper in three directions.
 
 use super::Relative;
-use crate::vehicle::body::{Attachment, BodyState, Wrench};
-use nalgebra::Vector3;
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
+use crate::vehicle::body::{Attachment, BodyState, Wrench};
+use nalgebra::Vector3;
 use serde::Deserialize;
 
 /// Shear pad between a side frame (upper) and a wheelset's axle box (lower).

@@ -7,10 +7,10 @@
 //! nest, would be an inverted pendulum.
 
 use super::Relative;
-use crate::vehicle::body::{Attachment, BodyState, Wrench};
-use nalgebra::Vector3;
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
+use crate::vehicle::body::{Attachment, BodyState, Wrench};
+use nalgebra::Vector3;
 use serde::Deserialize;
 
 /// Vertical force–compression law of a two-stage nest.

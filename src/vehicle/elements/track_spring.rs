@@ -2,10 +2,10 @@
 //! frame, as used by Wickens' single restrained wheelset (a wheelset held by springs to a
 //! frame that runs exactly along the track). Not part of a real wagon.
 
-use crate::vehicle::body::{BodyState, Wrench};
-use nalgebra::Matrix3;
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
+use crate::vehicle::body::{BodyState, Wrench};
+use nalgebra::Matrix3;
 use serde::Deserialize;
 
 /// Lateral and yaw spring between a body and the track frame at its position.
