@@ -1,30 +1,21 @@
-//! Contact model against closed forms and the CONTACT reference data in ../shared/reference.
+//! Contact model against closed forms and the CONTACT reference data in assets/reference.
 
 use railforce::contact::profile::{self, LoadOptions, Profile};
-use railforce::contact::validate::{self, ProfileSource};
+use railforce::contact::validate::{self, ProfileSource, Reference};
 use railforce::contact::{Side, WheelsetGeometry};
 use std::path::{Path, PathBuf};
 
-/// The reference folder, or `None` (skip) when absent outside CI; CI without it is an error.
-fn reference_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/reference");
-    if dir.join("mbench_a22_reference.json").exists() {
-        return Some(dir);
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!(
-            "reference data missing at {} while CI is set: the contact validation cannot run",
-            dir.display()
-        );
-    }
-    eprintln!("skipping: no reference data at {}", dir.display());
-    None
+/// The reference data: the copies in the repository (`assets/reference/`, origin and licence
+/// in its README), read from disk here; the binary embeds the same files.
+fn reference_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/reference")
 }
 
 #[test]
 fn manchester_a22_with_benchmark_profiles_within_tolerance() {
-    let Some(dir) = reference_dir() else { return };
-    let rows = validate::manchester_a22(&dir, ProfileSource::Benchmark).unwrap();
+    let dir = reference_dir();
+    let rows =
+        validate::manchester_a22(&Reference::Dir(dir.clone()), ProfileSource::Benchmark).unwrap();
     assert_eq!(rows.len(), 42, "21 cases × 2 wheels");
     for r in &rows {
         assert!(
@@ -58,7 +49,7 @@ fn manchester_a22_with_benchmark_profiles_within_tolerance() {
 
 #[test]
 fn analytic_profiles_match_the_benchmark_files() {
-    let Some(dir) = reference_dir() else { return };
+    let dir = reference_dir();
     // Wheel: the analytic S1002 against the benchmark's sampled S1002.
     let bench = profile::load(
         &dir.join("profiles/MBench_S1002_v3.prw"),
@@ -95,8 +86,7 @@ fn analytic_profiles_match_the_benchmark_files() {
 
 #[test]
 fn creep_curve_polach_and_fastsim_against_contact() {
-    let Some(dir) = reference_dir() else { return };
-    let rows = validate::tractcurv(&dir).unwrap();
+    let rows = validate::tractcurv(&Reference::Builtin).unwrap();
     assert_eq!(rows.len(), 60);
     for r in &rows {
         assert!(

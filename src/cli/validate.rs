@@ -40,9 +40,9 @@ enum What {
     /// profiles); creep force 0.065·μFn for Polach, 0.01·μFn for FASTSIM.
     Contact {
         /// Folder with mbench_a22_reference.json, contact_tractcurv_reference.csv and
-        /// profiles/ (the project's ../shared/reference).
-        #[arg(long, default_value = "../shared/reference")]
-        reference_dir: PathBuf,
+        /// profiles/ [default: the copies built into railforce, assets/reference].
+        #[arg(long)]
+        reference_dir: Option<PathBuf>,
     },
     /// The simulator's physics checks (spec §6): static wheel loads, quasi-static curving
     /// forces on R 400 m at 60 km/h and R 800 m at 100 km/h, Klingel's wavelength of a free
@@ -76,7 +76,10 @@ pub fn run(args: ValidateArgs) -> Result<()> {
             jobs,
             limits,
         } => super::identify::validate(&model, &plan, seed, jobs, &limits.limits()),
-        What::Contact { reference_dir } => contact(&reference_dir),
+        What::Contact { reference_dir } => contact(&match reference_dir {
+            Some(d) => cv::Reference::Dir(d),
+            None => cv::Reference::Builtin,
+        }),
         What::Dynamics {
             vehicle,
             empty,
@@ -278,7 +281,8 @@ fn fidelity(
     Ok(())
 }
 
-fn contact(dir: &std::path::Path) -> Result<()> {
+fn contact(dir: &cv::Reference) -> Result<()> {
+    println!("reference data: {}", dir.describe());
     let mut misses = 0;
     for (source, gate) in [
         (ProfileSource::Benchmark, true),

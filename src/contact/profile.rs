@@ -386,6 +386,13 @@ pub struct LoadOptions {
 /// use [`LoadOptions::mirror_y`] otherwise.
 pub fn load(path: &Path, opts: LoadOptions) -> Result<Profile> {
     let text = crate::io::read_text(path)?;
+    parse(&text, path, opts)
+}
+
+/// Parses profile text as [`load`] reads a file; `path` gives the format (by extension), the
+/// profile's name and the file named in errors.
+pub fn parse(text: &str, path: &Path, opts: LoadOptions) -> Result<Profile> {
+    let text = text.to_string();
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())

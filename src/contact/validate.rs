@@ -1,7 +1,7 @@
 //! Validation of the contact model against reference solutions of the CONTACT code
 //! (Vollebregt & Kalker): the Manchester contact benchmark case and the `tractcurv`
-//! creep-force curve. The reference files are read from a directory given by the user (the
-//! project's `../shared/reference/`); they are test oracles, never copied into the project.
+//! creep-force curve. The reference files (`assets/reference/`, origin and licence in its
+//! README) are embedded in the binary; another copy can be read from a folder.
 
 use super::creep::{CreepContact, CreepLaw, Creepage};
 use super::geometry::{Side, WheelsetGeometry};
@@ -9,7 +9,6 @@ use super::hertz::Material;
 use super::profile::{self, LoadOptions};
 use crate::error::{Error, Result};
 use serde::Deserialize;
-use std::path::Path;
 
 /// Tolerance on the contact position on the rail, m.
 pub const POSITION_TOLERANCE: f64 = 1e-3;
@@ -42,6 +41,61 @@ struct BenchCase {
 struct BenchPatch {
     ycp_track_mm: f64,
     delta_rad: f64,
+}
+
+/// Where the reference files come from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Reference {
+    /// The copies embedded in the binary (`assets/reference/`).
+    Builtin,
+    /// A folder holding the same files.
+    Dir(std::path::PathBuf),
+}
+
+impl Reference {
+    /// The text of reference file `name` (relative path, e.g. `profiles/MBench_S1002_v3.prw`)
+    /// and the path to name in messages.
+    fn read(&self, name: &str) -> Result<(String, std::path::PathBuf)> {
+        match self {
+            Reference::Dir(d) => {
+                let p = d.join(name);
+                Ok((crate::io::read_text(&p)?, p))
+            }
+            Reference::Builtin => {
+                let text = match name {
+                    "mbench_a22_reference.json" => {
+                        include_str!("../../assets/reference/mbench_a22_reference.json")
+                    }
+                    "contact_tractcurv_reference.csv" => {
+                        include_str!("../../assets/reference/contact_tractcurv_reference.csv")
+                    }
+                    "profiles/MBench_S1002_v3.prw" => {
+                        include_str!("../../assets/reference/profiles/MBench_S1002_v3.prw")
+                    }
+                    "profiles/MBench_UIC60_v3.prr" => {
+                        include_str!("../../assets/reference/profiles/MBench_UIC60_v3.prr")
+                    }
+                    _ => {
+                        return Err(Error::Domain(format!(
+                            "no built-in reference file '{name}'"
+                        )));
+                    }
+                };
+                Ok((
+                    text.to_string(),
+                    std::path::Path::new("<built-in>/assets/reference").join(name),
+                ))
+            }
+        }
+    }
+
+    /// Where the files come from, for reports.
+    pub fn describe(&self) -> String {
+        match self {
+            Reference::Builtin => "built-in (assets/reference)".into(),
+            Reference::Dir(d) => d.display().to_string(),
+        }
+    }
 }
 
 /// Which profiles an run uses.
@@ -85,23 +139,22 @@ impl A22Row {
 /// left and z up; the benchmark's y points right, so shifts, yaw and positions change sign.
 /// Contact positions are the load centres of the elastic patches
 /// ([`WheelsetGeometry::patch_centroid`]).
-pub fn manchester_a22(reference_dir: &Path, source: ProfileSource) -> Result<Vec<A22Row>> {
-    let json_path = reference_dir.join("mbench_a22_reference.json");
-    let text = crate::io::read_text(&json_path)?;
+pub fn manchester_a22(reference: &Reference, source: ProfileSource) -> Result<Vec<A22Row>> {
+    let (text, json_path) = reference.read("mbench_a22_reference.json")?;
     let bench: BenchFile = serde_json::from_str(&text).map_err(|e| Error::Parse {
         file: json_path.clone(),
         message: e.to_string(),
     })?;
     let (wheel, rail, inclination) = match source {
         ProfileSource::Benchmark => (
-            profile::load(
-                &reference_dir.join("profiles/MBench_S1002_v3.prw"),
-                LoadOptions::default(),
-            )?,
-            profile::load(
-                &reference_dir.join("profiles/MBench_UIC60_v3.prr"),
-                LoadOptions::default(),
-            )?,
+            {
+                let (t, p) = reference.read("profiles/MBench_S1002_v3.prw")?;
+                profile::parse(&t, &p, LoadOptions::default())?
+            },
+            {
+                let (t, p) = reference.read("profiles/MBench_UIC60_v3.prr")?;
+                profile::parse(&t, &p, LoadOptions::default())?
+            },
             0.0,
         ),
         ProfileSource::Analytic => (
@@ -170,9 +223,8 @@ impl CreepRow {
 /// `tractcurv` case (Fn 106.7 kN, a/b 0.5, μ 0.33, G 82 GPa, ν 0.28, pure longitudinal
 /// creepage). The ellipse area follows from the exact solution's peak pressure,
 /// `ab = 3Fn/(2π·p_max)`.
-pub fn tractcurv(reference_dir: &Path) -> Result<Vec<CreepRow>> {
-    let path = reference_dir.join("contact_tractcurv_reference.csv");
-    let text = crate::io::read_text(&path)?;
+pub fn tractcurv(reference: &Reference) -> Result<Vec<CreepRow>> {
+    let (text, path) = reference.read("contact_tractcurv_reference.csv")?;
     let (normal, mu) = (106.7e3, 0.33);
     let mut rows = Vec::new();
     let mut ab = None;
