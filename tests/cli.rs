@@ -235,3 +235,55 @@ fn select_onboard_then_train_on_noisy_inputs() {
         meta["data"]["split"]
     );
 }
+
+/// After `cargo install` the repository's files are not beside the binary: from an empty
+/// folder, the default vehicle and a named track come from the built-in copies, and
+/// `railforce init` writes them out to edit (refusing to overwrite without --force).
+#[test]
+fn built_in_vehicles_and_tracks_work_from_an_empty_folder() {
+    let dir = std::env::temp_dir().join(format!("railforce-empty-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (ok, out, err) = run(&[
+        "simulate",
+        "--track",
+        "tracks/tangent.toml",
+        "--duration",
+        "0.2",
+        "--settle",
+        "0.1",
+        "--out",
+        "run.csv",
+    ]);
+    assert!(ok, "{out}\n{err}");
+    assert!(err.contains("built-in"), "{err}");
+    assert!(dir.join("run.csv").exists());
+    let (ok, out, err) = run(&["init", "mine"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("wrote"), "{out}");
+    for f in [
+        "vehicles/c80.toml",
+        "vehicles/c80.urdf",
+        "tracks/paper34.plan.toml",
+    ] {
+        let a = std::fs::read_to_string(dir.join("mine").join(f)).unwrap();
+        let b = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(f))
+            .unwrap();
+        assert_eq!(a, b, "{f}");
+    }
+    let (ok, _, err) = run(&["init", "mine"]);
+    assert!(!ok && err.contains("--force"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -129,11 +129,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench simulate`");
             }
-            let v = railforce::vehicle::Vehicle::load(&vehicle)?;
+            let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&vehicle)?)?;
             let t0 = std::time::Instant::now();
             v.contact.table();
             let table_s = t0.elapsed().as_secs_f64();
-            let tr = railforce::track::Track::load(&track)?;
+            let tr = railforce::track::Track::load(&super::builtin::resolve(&track)?)?;
             let b = railforce::bench::simulate::run(&v, &tr, speed_kmh / 3.6, seconds)?;
             println!(
                 "simulation benchmark: {} on {}, {speed_kmh} km/h, {seconds} s, step {} ms, one thread",
@@ -161,7 +161,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench contact`");
             }
-            let v = railforce::vehicle::Vehicle::load(&vehicle)?;
+            let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&vehicle)?)?;
             let b = railforce::bench::contact::run(&v, iterations);
             println!(
                 "contact benchmark ({}: {} on {}, one thread, 122.6 kN, 60 km/h)",

@@ -107,7 +107,9 @@ pub fn run(args: ContactArgs) -> Result<()> {
         bail!("--load-kn, --speed-kmh and --mu must be positive");
     }
     let vehicle = match &args.vehicle {
-        Some(p) => Some(railforce::vehicle::Vehicle::load(p)?),
+        Some(p) => Some(railforce::vehicle::Vehicle::load(
+            &super::builtin::resolve(p)?,
+        )?),
         None => None,
     };
     let (geo, model, mass) = match &vehicle {

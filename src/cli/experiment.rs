@@ -117,7 +117,7 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
             WhichArg::All => Which::All,
         })
         .collect();
-    let mut opts = ExperimentOptions::full(args.plan, args.out);
+    let mut opts = ExperimentOptions::full(super::builtin::resolve(&args.plan)?, args.out);
     opts.condition = args.condition;
     opts.snr_db = args.snr_db;
     opts.jobs = args.jobs;
@@ -183,5 +183,8 @@ pub fn demo(args: DemoArgs) -> Result<()> {
     eprintln!(
         "railforce demo: simulate 3 short conditions, train a CNN-BiLSTM and GBDT, sweep 2 SNRs, write the report"
     );
-    run_with(&[Which::Paper], &demo_options(args.plan, args.out))
+    run_with(
+        &[Which::Paper],
+        &demo_options(super::builtin::resolve(&args.plan)?, args.out),
+    )
 }

@@ -53,7 +53,8 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let plan_path = args.plan.expect("clap requires --plan without --merge");
+    let plan_path =
+        super::builtin::resolve(&args.plan.expect("clap requires --plan without --merge"))?;
     let plan = Plan::load(&plan_path)?;
     let format = Format::parse(&args.format).ok_or_else(|| {
         anyhow::anyhow!("--format must be npz, parquet or csv, got {}", args.format)

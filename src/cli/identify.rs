@@ -220,7 +220,7 @@ pub fn validate(
     limits: &Limits,
 ) -> Result<()> {
     let mut model = Model::load(model_dir)?;
-    let plan = railforce::plan::Plan::load(plan)?;
+    let plan = railforce::plan::Plan::load(&super::builtin::resolve(plan)?)?;
     let seed = seed.unwrap_or_else(|| railforce::identify::closed_loop::fresh_seed(&model));
     let work = model_dir.join(format!("closed_loop_seed{seed}"));
     let noise = match model.meta.data.noise {

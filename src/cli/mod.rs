@@ -2,6 +2,7 @@
 //! arguments into library calls and library results into text.
 
 mod bench;
+mod builtin;
 mod contact;
 mod experiment;
 mod generate;
@@ -38,10 +39,10 @@ enum Command {
     /// Contact of both wheels of a wheelset in a given state: contact points, angles,
     /// ellipses, creepages and forces.
     ///
-    /// Solves the rigid contact geometry for the lateral shift and yaw, shares each wheel's
-    /// load between its contact points (two-point contact), and evaluates Hertz and the creep
-    /// law. Forces are those of the rail on the wheel: Fx, Fy in the contact plane; Y (+ left)
-    /// and Q (+ up) in the track frame.
+    /// The same evaluation a simulation step runs (elastic strip contact: one or two patches
+    /// per wheel, Hertz ellipse, creepages, creep law), at the wheelset height where each
+    /// wheel carries the given load. Forces are those of the rail on the wheel: Fx, Fy in the
+    /// contact plane; Y (+ left) and Q (+ up) in the track frame.
     Contact(contact::ContactArgs),
     /// Simulate a vehicle on a track and record the 21 sensor channels, the forces of every
     /// wheel and the motion of every body at 200 Hz.
@@ -99,6 +100,34 @@ enum Command {
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
     /// `bench learn`).
     Bench(bench::BenchArgs),
+    /// Write the built-in vehicles, tracks and plans (the C80 loaded and empty, the paper's 34
+    /// conditions, the demo plan) into DIR to edit them.
+    ///
+    /// railforce carries these files: a command given a path that does not exist but names a
+    /// built-in file (e.g. `vehicles/c80.toml`, `tracks/demo.plan.toml`) uses the built-in
+    /// copy, so the defaults work from any folder after `cargo install`; files you give always
+    /// take precedence.
+    Init(InitArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct InitArgs {
+    /// Folder to write into (vehicles/ and tracks/ are created inside).
+    #[arg(default_value = ".")]
+    dir: std::path::PathBuf,
+    /// Overwrite files that exist.
+    #[arg(long)]
+    force: bool,
+}
+
+fn init(args: InitArgs) -> anyhow::Result<()> {
+    let written = builtin::write_all(&args.dir, args.force)?;
+    println!(
+        "wrote {} files under {} (vehicles/, tracks/)",
+        written.len(),
+        args.dir.display()
+    );
+    Ok(())
 }
 
 /// Parses the command line, runs the subcommand and turns errors into a message and exit 1.
@@ -117,6 +146,7 @@ pub fn main() -> ExitCode {
         Command::Demo(args) => experiment::demo(args),
         Command::Validate(args) => validate::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Init(args) => init(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

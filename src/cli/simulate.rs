@@ -49,6 +49,9 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     if args.settle.is_nan() || args.settle < 0.0 {
         bail!("--settle must not be negative, got {}", args.settle);
     }
+    let mut args = args;
+    args.vehicle = super::builtin::resolve(&args.vehicle)?;
+    args.track = super::builtin::resolve(&args.track)?;
     let vehicle = Vehicle::load(&args.vehicle)?;
     let track = Track::new(TrackSpec::load(&args.track)?, args.seed);
     let cfg = SimConfig {

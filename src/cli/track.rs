@@ -28,7 +28,7 @@ pub struct TrackArgs {
 }
 
 pub fn run(args: TrackArgs) -> Result<()> {
-    let spec = TrackSpec::load(&args.file)?;
+    let spec = TrackSpec::load(&super::builtin::resolve(&args.file)?)?;
     let track = Track::new(spec, args.seed);
     print_summary(&track);
     if let Some(out) = &args.out {

@@ -96,7 +96,7 @@ fn dynamics(
     restrained: &std::path::Path,
 ) -> Result<()> {
     use railforce::sim::checks;
-    let v = railforce::vehicle::Vehicle::load(vehicle)?;
+    let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(vehicle)?)?;
     let mut misses = 0;
     let mut verdict = |ok: bool| {
         if !ok {
@@ -131,7 +131,7 @@ fn dynamics(
         ("tracks/curve_r400.toml", 60.0),
         ("tracks/curve_r800.toml", 100.0),
     ] {
-        let track = checks::with_class(std::path::Path::new(file), 6)?;
+        let track = checks::with_class(&super::builtin::resolve(std::path::Path::new(file))?, 6)?;
         let c = checks::curving(&v, &track, kmh / 3.6, 250.0)?;
         let dev = (c.sum_y - c.expected_y).abs() / c.expected_y.abs();
         let a_nc = (kmh / 3.6f64).powi(2) / c.radius - railforce::GRAVITY * c.cant_angle.tan();
@@ -161,7 +161,7 @@ fn dynamics(
             verdict(outer_more)
         );
     }
-    let w = railforce::vehicle::Vehicle::load(wheelset)?;
+    let w = railforce::vehicle::Vehicle::load(&super::builtin::resolve(wheelset)?)?;
     let k = checks::klingel(&w, 5.0, 2e-3, 4)?;
     let dev = (k.measured / k.expected - 1.0).abs();
     println!("Klingel, free wheelset ({}), 5 m/s, 2 mm start:", w.name);
@@ -175,7 +175,7 @@ fn dynamics(
         dev * 100.0,
         verdict(dev < 0.01)
     );
-    let r = railforce::vehicle::Vehicle::load(restrained)?;
+    let r = railforce::vehicle::Vehicle::load(&super::builtin::resolve(restrained)?)?;
     let wk = checks::wickens(&r)?;
     let dev = (wk.measured / wk.expected - 1.0).abs();
     println!("Wickens, restrained wheelset ({}):", r.name);
@@ -212,7 +212,9 @@ fn fidelity(
         cfg.output_rate,
         verdict(db <= -40.0)
     );
-    let track = railforce::track::Track::load(std::path::Path::new("tracks/curve_r400.toml"))?;
+    let track = railforce::track::Track::load(&super::builtin::resolve(std::path::Path::new(
+        "tracks/curve_r400.toml",
+    ))?)?;
     let (speed, secs) = (60.0 / 3.6, 15.0);
     let fine = fd::run(v, &track, speed, secs, cfg.dt / 4.0)?;
     let base = fd::run(v, &track, speed, secs, cfg.dt)?;
@@ -247,8 +249,10 @@ fn fidelity(
         jitter * 1e3,
         verdict(jitter < 1e-3)
     );
-    let smooth = fd::smooth(std::path::Path::new("tracks/tangent.toml"))?;
-    let e = railforce::vehicle::Vehicle::load(empty)?;
+    let smooth = fd::smooth(&super::builtin::resolve(std::path::Path::new(
+        "tracks/tangent.toml",
+    ))?)?;
+    let e = railforce::vehicle::Vehicle::load(&super::builtin::resolve(empty)?)?;
     let (from, to) = (150.0 / 3.6, 50.0 / 3.6);
     let mut found = Vec::new();
     for w in [v, &e] {
