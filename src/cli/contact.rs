@@ -29,6 +29,9 @@ pub struct WheelsetArgs {
     /// Nominal rolling radius at the tape circle, mm.
     #[arg(long, default_value_t = 420.0)]
     pub r0_mm: f64,
+    /// Tape circle outside the flange back, mm (70 for S1002).
+    #[arg(long, default_value_t = 70.0)]
+    pub tape_offset_mm: f64,
 }
 
 impl WheelsetArgs {
@@ -51,7 +54,7 @@ impl WheelsetArgs {
             incl,
             self.gauge_mm * 1e-3,
             self.flange_back_mm * 1e-3,
-            0.070,
+            self.tape_offset_mm * 1e-3,
             self.r0_mm * 1e-3,
         )?)
     }

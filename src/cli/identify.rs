@@ -19,19 +19,31 @@ pub struct LimitArgs {
     /// Wheel unloading ΔQ/Q̄ limit (0.65 allowable, 0.60 preferred).
     #[arg(long, default_value_t = 0.65)]
     pub limit_unloading: f64,
-    /// Static wheel load Q̄, kN (C80: 25 t axle load → 122.6 kN); H's limit 0.85·(10 + P_st/3)
-    /// follows from it.
-    #[arg(long, default_value_t = 122.625)]
-    pub static_wheel_load_kn: f64,
+    /// Static wheel load Q̄, kN [default: the --vehicle's weight over its wheels]; H's limit
+    /// 0.85·(10 + P_st/3) follows from it.
+    #[arg(long)]
+    pub static_wheel_load_kn: Option<f64>,
+    /// Vehicle whose weight gives the static wheel load (C80 loaded: 100 t on 8 wheels →
+    /// 122.6 kN).
+    #[arg(long, default_value = "vehicles/c80.toml")]
+    pub vehicle: PathBuf,
 }
 
 impl LimitArgs {
-    pub fn limits(&self) -> Limits {
-        Limits {
+    pub fn limits(&self) -> Result<Limits> {
+        let static_wheel_load_kn = match self.static_wheel_load_kn {
+            Some(q) => q,
+            None => {
+                let v =
+                    railforce::vehicle::Vehicle::load(&super::builtin::resolve(&self.vehicle)?)?;
+                v.mass() * railforce::GRAVITY / (2 * v.contact.wheelsets.len()) as f64 * 1e-3
+            }
+        };
+        Ok(Limits {
             y_over_q: self.limit_yq,
             unloading: self.limit_unloading,
-            static_wheel_load_kn: self.static_wheel_load_kn,
-        }
+            static_wheel_load_kn,
+        })
     }
 }
 
@@ -64,7 +76,7 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
     let t0 = std::time::Instant::now();
     let id = identify(&mut model, &input);
     let secs = t0.elapsed().as_secs_f64();
-    let reports = indices(&id, &args.limits.limits());
+    let reports = indices(&id, &args.limits.limits()?);
     let mut s = String::from("time_s");
     for t in &id.targets {
         let _ = write!(s, ",{t}_N");

@@ -75,7 +75,7 @@ pub fn run(args: ValidateArgs) -> Result<()> {
             seed,
             jobs,
             limits,
-        } => super::identify::validate(&model, &plan, seed, jobs, &limits.limits()),
+        } => super::identify::validate(&model, &plan, seed, jobs, &limits.limits()?),
         What::Contact { reference_dir } => contact(&match reference_dir {
             Some(d) => cv::Reference::Dir(d),
             None => cv::Reference::Builtin,

@@ -48,8 +48,17 @@ pub struct SimConfig {
     pub start: Option<f64>,
     /// Stop the run at a derailment (otherwise it is only reported).
     pub stop_on_derailment: bool,
-    /// Flange angle for the Nadal limit, rad.
-    pub nadal_angle: f64,
+    /// Flange angle for the Nadal limit, rad (None: the vehicle's `contact.flange_angle_deg`).
+    pub nadal_angle: Option<f64>,
+    /// How long |Y/Q| may stay above Nadal's limit before a derailment is declared, s.
+    pub nadal_time: f64,
+    /// A wheel risen on its flange by this share of the flange height (lift included) has
+    /// derailed (the flange tip is rounded).
+    pub climb_limit: f64,
+    /// A wheel this far sideways from its rail (m) has derailed.
+    pub lateral_limit: f64,
+    /// A body moving this fast away from the running motion (m/s) means the run diverged.
+    pub runaway_speed: f64,
     /// Lateral offset of the whole vehicle at the start, m (a perturbation for stability and
     /// kinematic-oscillation checks).
     pub initial_offset: f64,
@@ -66,16 +75,21 @@ impl Default for SimConfig {
             cutoff: 50.0,
             start: None,
             stop_on_derailment: true,
-            nadal_angle: 70f64.to_radians(),
+            nadal_angle: None,
+            nadal_time: 0.05,
+            climb_limit: 0.9,
+            lateral_limit: 39e-3,
+            runaway_speed: 20.0,
             initial_offset: 0.0,
         }
     }
 }
 
 impl SimConfig {
-    /// Nadal's flange-climb limit `(tan δ − μ)/(1 + μ·tan δ)`.
+    /// Nadal's flange-climb limit `(tan δ − μ)/(1 + μ·tan δ)` for the flange angle δ given
+    /// here, else 70°.
     pub fn nadal_limit(&self, mu: f64) -> f64 {
-        let t = self.nadal_angle.tan();
+        let t = self.nadal_angle.unwrap_or(70f64.to_radians()).tan();
         (t - mu) / (1.0 + mu * t)
     }
 }
@@ -130,6 +144,20 @@ impl<'a> Simulation<'a> {
             return Err(Error::Domain(format!(
                 "the integration step must lie in (0, 1 ms], got {} s",
                 cfg.dt
+            )));
+        }
+        // The contact table is built for the vehicle's gauge: the track must have it.
+        let (tg, vg) = (
+            track.spec().gauge,
+            2.0 * vehicle.contact.geometry.half_gauge,
+        );
+        if (tg - vg).abs() > 5e-4 {
+            return Err(Error::Domain(format!(
+                "track '{}' has gauge {:.1} mm but vehicle '{}' is built for {:.1} mm (contact.gauge_m): the contact geometry would not match",
+                track.spec().name,
+                tg * 1e3,
+                vehicle.name,
+                vg * 1e3
             )));
         }
         let xs: Vec<f64> = vehicle.bodies.iter().map(|b| b.position.x).collect();
@@ -419,7 +447,7 @@ impl<'a> Simulation<'a> {
                     self.time
                 )));
             }
-            if rel_v.norm() > 20.0 {
+            if rel_v.norm() > self.cfg.runaway_speed {
                 return Err(Error::Domain(format!(
                     "simulation diverged at t = {:.4} s: body '{name}' moves {:.1} m/s away from the running motion (runaway energy)",
                     self.time,
@@ -427,14 +455,22 @@ impl<'a> Simulation<'a> {
                 )));
             }
         }
-        let limit = self.cfg.nadal_limit(self.vehicle.contact.friction);
+        let limit = SimConfig {
+            nadal_angle: Some(
+                self.cfg
+                    .nadal_angle
+                    .unwrap_or(self.vehicle.contact.flange_angle),
+            ),
+            ..SimConfig::default()
+        }
+        .nadal_limit(self.vehicle.contact.friction);
         let flange = self.flange_height;
         for k in 0..self.wheels.len() {
             let w = &self.wheels[k];
             let name = || wheel_name(k);
             // Climb: how far the wheel has risen on its flange (contact radius above the tape
             // circle) plus any gap; derailed at 90 % of the flange height (the tip is rounded).
-            if w.climb > 0.9 * flange || w.y_rel.abs() > 39e-3 {
+            if w.climb > self.cfg.climb_limit * flange || w.y_rel.abs() > self.cfg.lateral_limit {
                 let msg = format!(
                     "derailment at t = {:.3} s, s = {:.1} m: wheel {} climbed {:.1} mm of its {:.1} mm flange (lateral shift {:.1} mm relative to its rail)",
                     self.time,
@@ -454,12 +490,13 @@ impl<'a> Simulation<'a> {
             } else {
                 self.over_nadal[k] = 0.0;
             }
-            if self.over_nadal[k] > 0.05 {
+            if self.over_nadal[k] > self.cfg.nadal_time {
                 let msg = format!(
-                    "derailment risk at t = {:.3} s, s = {:.1} m: wheel {} has |Y/Q| above the Nadal limit {limit:.3} for more than 50 ms",
+                    "derailment risk at t = {:.3} s, s = {:.1} m: wheel {} has |Y/Q| above the Nadal limit {limit:.3} for more than {:.0} ms",
                     self.time,
                     w.s,
-                    name()
+                    name(),
+                    self.cfg.nadal_time * 1e3
                 );
                 if self.cfg.stop_on_derailment {
                     return Err(Error::Domain(msg));

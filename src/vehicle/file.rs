@@ -59,6 +59,19 @@ struct ContactFile {
     poisson: f64,
     #[serde(default = "default_damping_ratio")]
     damping_ratio: f64,
+    /// Tape circle outside the flange back, m (70 mm for S1002).
+    #[serde(default = "default_tape_offset")]
+    tape_offset_m: f64,
+    /// Largest flange angle of the wheel profile, degrees (Nadal's limit).
+    #[serde(default = "default_flange_angle")]
+    flange_angle_deg: f64,
+}
+
+fn default_tape_offset() -> f64 {
+    0.070
+}
+fn default_flange_angle() -> f64 {
+    70.0
 }
 
 fn default_gauge() -> f64 {
@@ -226,6 +239,12 @@ pub(super) fn load(path: &Path) -> Result<Vehicle> {
     positive("contact.young_pa".into(), c.young_pa)?;
     non_negative("contact.rail_inclination".into(), &[c.rail_inclination])?;
     non_negative("contact.damping_ratio".into(), &[c.damping_ratio])?;
+    if !(c.flange_angle_deg > 30.0 && c.flange_angle_deg < 89.0) {
+        return Err(cfg(
+            "contact.flange_angle_deg".into(),
+            format!("must lie in (30, 89)°, got {}", c.flange_angle_deg),
+        ));
+    }
     if !(0.0..0.5).contains(&c.poisson) {
         return Err(cfg(
             "contact.poisson".into(),
@@ -272,7 +291,7 @@ pub(super) fn load(path: &Path) -> Result<Vehicle> {
         inclination,
         c.gauge_m,
         c.flange_back_m,
-        0.070,
+        positive("contact.tape_offset_m".into(), c.tape_offset_m)?,
         c.nominal_radius_m,
     )
     .map_err(|e| cfg("contact".into(), e.to_string()))?;
@@ -339,6 +358,7 @@ pub(super) fn load(path: &Path) -> Result<Vehicle> {
                 poisson: c.poisson,
             },
             damping_ratio: c.damping_ratio,
+            flange_angle: c.flange_angle_deg.to_radians(),
             table: std::sync::OnceLock::new(),
         },
         hauling,

@@ -34,6 +34,8 @@ pub struct ContactSettings {
     pub material: Material,
     /// Damping ratio of the normal contact.
     pub damping_ratio: f64,
+    /// Largest flange angle of the wheel profile, rad (Nadal's limit).
+    pub flange_angle: f64,
     /// Contact table, built on first use and shared by every run of this vehicle.
     pub(crate) table: std::sync::OnceLock<crate::contact::ContactTable>,
 }
