@@ -413,7 +413,15 @@ pub fn merge(out: &Path) -> Result<Value> {
     }
     let mut merged: Option<Value> = None;
     for path in &shards {
-        let m = read_manifest(path)?.expect("listed file exists");
+        let m = read_manifest(path)?
+            .ok_or_else(|| Error::Domain(format!("{} disappeared", path.display())))?;
+        if !m.is_object() || !m["runs"].is_array() {
+            return Err(Error::config(
+                path,
+                "runs",
+                "missing or not a list: not a railforce shard manifest",
+            ));
+        }
         match merged.as_mut() {
             None => merged = Some(m),
             Some(all) => {
@@ -429,11 +437,18 @@ pub fn merge(out: &Path) -> Result<Value> {
                     all["channels"] = m["channels"].clone();
                 }
                 let runs = m["runs"].as_array().cloned().unwrap_or_default();
-                all["runs"].as_array_mut().expect("runs").extend(runs);
+                if let Some(all_runs) = all["runs"].as_array_mut() {
+                    all_runs.extend(runs);
+                }
             }
         }
     }
-    let mut m = merged.expect("at least one shard");
+    let Some(mut m) = merged else {
+        return Err(Error::Domain(format!(
+            "no shard manifest in {}",
+            out.display()
+        )));
+    };
     m["shard"] = Value::Null;
     m["merged_from"] = shards
         .iter()

@@ -48,7 +48,14 @@ impl SensorTable {
                 TIME_COLUMNS.join(", ")
             )));
         };
-        let (_, time) = cols.remove(k);
+        let (name, time) = cols.remove(k);
+        if let Some(row) = time.iter().position(|t| !t.is_finite()) {
+            return Err(Error::Domain(format!(
+                "{source}: column {name}, row {}: the time is {} (every time must be a finite number)",
+                row + 1,
+                time[row]
+            )));
+        }
         Ok(SensorTable {
             source,
             time,

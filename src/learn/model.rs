@@ -211,8 +211,13 @@ pub fn read_weights(path: &Path) -> Result<Vec<f32>> {
     if bytes.len() < 16 || &bytes[..8] != MAGIC {
         return Err(Error::config(path, "header", "not a railforce weight file"));
     }
-    let n = u64::from_le_bytes(bytes[8..16].try_into().expect("8 bytes")) as usize;
-    if bytes.len() != 16 + 4 * n {
+    let n = u64::from_le_bytes(bytes[8..16].try_into().expect("8 bytes"));
+    // A count from the file: checked, never trusted to fit.
+    let expected = n
+        .checked_mul(4)
+        .and_then(|b| b.checked_add(16))
+        .and_then(|b| usize::try_from(b).ok());
+    if expected != Some(bytes.len()) {
         return Err(Error::config(path, "length", "truncated weight file"));
     }
     Ok(bytes[16..]

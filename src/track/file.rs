@@ -11,6 +11,11 @@ use std::path::{Path, PathBuf};
 /// Largest cant accepted, in mm (Chinese and European practice stay below 150–180 mm; 200 mm
 /// is the hard ceiling).
 pub const MAX_CANT_MM: f64 = 200.0;
+/// Longest track accepted, m.
+pub const MAX_LENGTH_M: f64 = 200e3;
+/// Most irregularity samples per channel (length over λ_min/16).
+pub const MAX_IRREGULARITY_SAMPLES: f64 = 4e6;
+
 /// Largest gradient accepted, in ‰ (mainline heavy haul stays below ~30 ‰).
 pub const MAX_GRADIENT_PERMILLE: f64 = 60.0;
 
@@ -272,6 +277,16 @@ impl TrackSpec {
             start += sf.length_m;
         }
         let length = start;
+        if length > MAX_LENGTH_M {
+            return Err(err(
+                "section".into(),
+                format!(
+                    "the sections add up to {:.0} km: at most {:.0} km (runs need a few km)",
+                    length * 1e-3,
+                    MAX_LENGTH_M * 1e-3
+                ),
+            ));
+        }
 
         let profile = match &raw.profile {
             None => VerticalProfile::level(0.0),
@@ -306,6 +321,15 @@ impl TrackSpec {
                     ));
                 }
                 check_range(path, "irregularity.fade_in_m", irr.fade_in_m, 0.0, 1000.0)?;
+                if length / (irr.min_wavelength_m / 16.0) > MAX_IRREGULARITY_SAMPLES {
+                    return Err(err(
+                        "irregularity.min_wavelength_m".into(),
+                        format!(
+                            "{} m on a {:.0} m track needs more than {:.0} samples per channel: use a longer shortest wavelength or a shorter track",
+                            irr.min_wavelength_m, length, MAX_IRREGULARITY_SAMPLES
+                        ),
+                    ));
+                }
                 check_range(
                     path,
                     "irregularity.smooth_start_m",

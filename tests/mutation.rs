@@ -1,0 +1,252 @@
+//! Every input file parses or says why, never panics (issue 19): valid files are mutated —
+//! truncated, bytes flipped, numbers replaced by NaN, ±inf, huge and negative values or a
+//! string, lines deleted or duplicated (duplicate keys) — and each loader must return either
+//! a value or an error that names the file; a panic fails the test. A bounded number of cases
+//! per file (seeded, so a failure reproduces).
+
+use std::path::{Path, PathBuf};
+
+const CASES: usize = 40;
+
+/// A small seeded generator (SplitMix64): the cases are the same on every run.
+struct Gen(u64);
+
+impl Gen {
+    fn random_range(&mut self, r: std::ops::Range<usize>) -> usize {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        r.start + (z % (r.end - r.start).max(1) as u64) as usize
+    }
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn mutate(text: &str, rng: &mut Gen) -> Vec<u8> {
+    let bytes = text.as_bytes();
+    match rng.random_range(0..5) {
+        0 => bytes[..rng.random_range(0..bytes.len())].to_vec(),
+        1 => {
+            let mut b = bytes.to_vec();
+            let i = rng.random_range(0..b.len());
+            b[i] ^= 1 << rng.random_range(0..8);
+            b
+        }
+        2 => {
+            // Replace one number with something hostile.
+            let nums: Vec<(usize, usize)> = {
+                let mut v = Vec::new();
+                let mut i = 0;
+                while i < bytes.len() {
+                    if bytes[i].is_ascii_digit() {
+                        let s = i;
+                        while i < bytes.len()
+                            && (bytes[i].is_ascii_digit() || b".eE-+".contains(&bytes[i]))
+                        {
+                            i += 1;
+                        }
+                        v.push((s, i));
+                    }
+                    i += 1;
+                }
+                v
+            };
+            if nums.is_empty() {
+                return bytes.to_vec();
+            }
+            let (s, e) = nums[rng.random_range(0..nums.len())];
+            let hostile = [
+                "nan",
+                "inf",
+                "-inf",
+                "1e308",
+                "-1e308",
+                "-5",
+                "0",
+                "\"x\"",
+                "18446744073709551615",
+            ];
+            let mut out = bytes[..s].to_vec();
+            out.extend_from_slice(hostile[rng.random_range(0..hostile.len())].as_bytes());
+            out.extend_from_slice(&bytes[e..]);
+            out
+        }
+        3 => {
+            let lines: Vec<&str> = text.lines().collect();
+            let k = rng.random_range(0..lines.len());
+            lines
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| *i != k)
+                .map(|(_, l)| *l)
+                .collect::<Vec<_>>()
+                .join("\n")
+                .into_bytes()
+        }
+        _ => {
+            let lines: Vec<&str> = text.lines().collect();
+            let k = rng.random_range(0..lines.len());
+            let mut out: Vec<&str> = lines.clone();
+            out.insert(k, lines[k]);
+            out.join("\n").into_bytes()
+        }
+    }
+}
+
+/// Mutates `name` (copied with its `siblings` into a scratch folder) `CASES` times and hands
+/// the mutated file's path to `load`.
+fn fuzz<T>(
+    tag: &str,
+    source: &Path,
+    siblings: &[&Path],
+    load: impl Fn(&Path) -> railforce::Result<T> + std::panic::RefUnwindSafe,
+) {
+    let dir = std::env::temp_dir().join(format!("railforce-mut-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for s in siblings {
+        std::fs::copy(s, dir.join(s.file_name().unwrap())).unwrap();
+    }
+    let text = std::fs::read_to_string(source).unwrap();
+    let target = dir.join(source.file_name().unwrap());
+    let name = target.file_name().unwrap().to_string_lossy().into_owned();
+    let mut rng = Gen(17);
+    for case in 0..CASES {
+        let bytes = mutate(&text, &mut rng);
+        std::fs::write(&target, &bytes).unwrap();
+        let result = std::panic::catch_unwind(|| load(&target).map(|_| ()));
+        match result {
+            Err(_) => panic!(
+                "{tag} case {case}: the loader panicked on\n{}",
+                String::from_utf8_lossy(&bytes)
+            ),
+            Ok(Err(e)) => {
+                let msg = e.to_string();
+                assert!(
+                    msg.contains(&name)
+                        || siblings
+                            .iter()
+                            .any(|s| msg.contains(&*s.file_name().unwrap().to_string_lossy())),
+                    "{tag} case {case}: the error does not name the file: {msg}"
+                );
+            }
+            Ok(Ok(())) => {}
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn vehicle_files_parse_or_say_why() {
+    let v = root().join("vehicles");
+    fuzz(
+        "vehicle",
+        &v.join("c80.toml"),
+        &[&v.join("c80.urdf")],
+        |p| railforce::vehicle::Vehicle::load(p),
+    );
+    fuzz("urdf", &v.join("c80.urdf"), &[&v.join("c80.toml")], |p| {
+        railforce::vehicle::Vehicle::load(&p.with_file_name("c80.toml"))
+    });
+}
+
+#[test]
+fn track_files_parse_or_say_why() {
+    fuzz("track", &root().join("tracks/grade20_L50.toml"), &[], |p| {
+        let spec = railforce::track::TrackSpec::load(p)?;
+        let t = railforce::track::Track::new(spec, None);
+        let r = t.at(0.5 * t.length()).rails;
+        assert!(r.left_y.is_finite() && r.left_z.is_finite());
+        Ok(())
+    });
+}
+
+#[test]
+fn plan_files_parse_or_say_why() {
+    fuzz("plan", &root().join("tracks/demo.plan.toml"), &[], |p| {
+        railforce::plan::Plan::load(p)
+    });
+}
+
+#[test]
+fn profile_files_parse_or_say_why() {
+    use railforce::contact::profile::{LoadOptions, load};
+    fuzz(
+        "profile-csv",
+        &root().join("vehicles/profiles/cone_1_40.csv"),
+        &[],
+        |p| load(p, LoadOptions::default()),
+    );
+    fuzz(
+        "profile-prw",
+        &root().join("assets/reference/profiles/MBench_S1002_v3.prw"),
+        &[],
+        |p| load(p, LoadOptions::default()),
+    );
+}
+
+#[test]
+fn sensor_files_parse_or_say_why() {
+    let dir = std::env::temp_dir().join(format!("railforce-mut-src-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("sensors.csv");
+    let mut text = String::from("time_s,ws1_acc_y,ws1_acc_z\n");
+    for i in 0..50 {
+        text += &format!(
+            "{:.3},{:.4},{:.4}\n",
+            i as f64 * 0.005,
+            (i as f64).sin(),
+            9.81 + 0.1 * (i as f64).cos()
+        );
+    }
+    std::fs::write(&csv, text).unwrap();
+    fuzz("sensors", &csv, &[], |p| {
+        let t = railforce::identify::SensorTable::read(p)?;
+        assert!(t.time.iter().all(|v| v.is_finite()));
+        Ok(())
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Weight files: a count that cannot fit, truncation, garbage — errors, never a panic.
+#[test]
+fn weight_files_parse_or_say_why() {
+    let dir = std::env::temp_dir().join(format!("railforce-mut-w-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("weights.bin");
+    railforce::learn::model::write_weights(&p, &[1.0, 2.0, 3.0]).unwrap();
+    let good = std::fs::read(&p).unwrap();
+    assert_eq!(
+        railforce::learn::model::read_weights(&p).unwrap(),
+        vec![1.0, 2.0, 3.0]
+    );
+    let mut huge = good.clone();
+    huge[8..16].copy_from_slice(&u64::MAX.to_le_bytes());
+    for bytes in [huge, good[..20].to_vec(), b"garbage".to_vec(), Vec::new()] {
+        std::fs::write(&p, &bytes).unwrap();
+        let e = railforce::learn::model::read_weights(&p).unwrap_err();
+        assert!(e.to_string().contains("weights.bin"), "{e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A shard manifest without its runs is refused by name.
+#[test]
+fn shard_manifest_without_runs_is_an_error() {
+    let dir = std::env::temp_dir().join(format!("railforce-mut-m-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("manifest.shard-1-of-2.json"),
+        "{\"format\": \"npz\"}",
+    )
+    .unwrap();
+    let e = railforce::dataset::merge(&dir).unwrap_err();
+    assert!(e.to_string().contains("manifest.shard-1-of-2.json"), "{e}");
+    std::fs::write(dir.join("manifest.shard-1-of-2.json"), "[1, 2]").unwrap();
+    assert!(railforce::dataset::merge(&dir).is_err());
+    let _ = std::fs::remove_dir_all(&dir);
+}
