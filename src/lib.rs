@@ -8,7 +8,6 @@
 
 #![warn(missing_docs)]
 
-pub mod bench;
 pub mod contact;
 pub mod dataset;
 pub mod dsp;

@@ -147,7 +147,7 @@ fn vehicle_files_parse_or_say_why() {
         "vehicle",
         &v.join("c80.toml"),
         &[&v.join("c80.urdf")],
-        |p| railforce::vehicle::Vehicle::load(p),
+        railforce::vehicle::Vehicle::load,
     );
     fuzz("urdf", &v.join("c80.urdf"), &[&v.join("c80.toml")], |p| {
         railforce::vehicle::Vehicle::load(&p.with_file_name("c80.toml"))

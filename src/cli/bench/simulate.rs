@@ -1,9 +1,9 @@
 //! Speed of the full wagon simulation: profile contact, class 5 irregularities, 11 bodies.
 
-use crate::error::Result;
-use crate::sim::{SimConfig, Simulation, output::Recorder};
-use crate::track::Track;
-use crate::vehicle::Vehicle;
+use railforce::error::Result;
+use railforce::sim::{SimConfig, Simulation, output::Recorder};
+use railforce::track::Track;
+use railforce::vehicle::Vehicle;
 use std::time::Instant;
 
 /// Result of the simulation benchmark.

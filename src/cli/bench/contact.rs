@@ -1,8 +1,8 @@
 //! Speed of one wheel's contact evaluation during a simulation step: the same function a run
-//! executes ([`crate::contact::evaluate`]), on the vehicle's own contact table.
+//! executes ([`railforce::contact::evaluate`]), on the vehicle's own contact table.
 
-use crate::contact::{CreepLaw, Side, WheelOnRail, evaluate, height_for_load};
-use crate::vehicle::Vehicle;
+use railforce::contact::{CreepLaw, Side, WheelOnRail, evaluate, height_for_load};
+use railforce::vehicle::Vehicle;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -33,7 +33,7 @@ pub fn run(vehicle: &Vehicle, iterations: usize) -> ContactBench {
     base.angular_velocity[2] = 0.01;
     base.yaw = 1e-3;
     let time_wheel = |law: CreepLaw, n: usize| {
-        let model = crate::contact::ContactModel { law, ..cs.model() };
+        let model = railforce::contact::ContactModel { law, ..cs.model() };
         // Heights that carry the load, every 0.12 mm of shift (not timed).
         let heights: Vec<f64> = (0..100)
             .map(|i| {

@@ -2,15 +2,13 @@
 //! the spec's PyTorch reference figures (learning.md §5) and this machine's sustained GEMM rate
 //! measured in the same run (the hardware reference the ratio is read against).
 
-use crate::learn::linalg::gemm;
-use crate::learn::neural::{Adam, Architecture, NetConfig, Network};
+use railforce::learn::linalg::gemm;
+use railforce::learn::neural::{Adam, Architecture, NetConfig, Network};
 use std::time::Instant;
 
 /// One architecture's figures.
 #[derive(Debug, Clone)]
 pub struct NetBench {
-    /// Network.
-    pub architecture: Architecture,
     /// Training windows per second (forward + backward + Adam) at the batch size.
     pub train_windows_per_s: f64,
     /// Inference windows per second in batches of 1024.
@@ -99,7 +97,6 @@ pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
         k += 1;
     }
     NetBench {
-        architecture,
         train_windows_per_s: train,
         infer_windows_per_s: infer,
         single_ms: t0.elapsed().as_secs_f64() * 1e3 / k as f64,
@@ -110,11 +107,11 @@ pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
 /// Seconds to fit `params` on `n` synthetic windows of `f` features (one output), and the
 /// test R² reached (a smooth nonlinear function of a few features, so the fit is real work).
 pub fn classical_fit(
-    params: crate::learn::classical::ClassicalParams,
+    params: railforce::learn::classical::ClassicalParams,
     n: usize,
     f: usize,
 ) -> (f64, f64) {
-    use crate::learn::classical::Classical;
+    use railforce::learn::classical::Classical;
     let make = |n: usize, seed: u64| -> (Vec<f32>, Vec<f32>) {
         let mut s = seed;
         let x: Vec<f32> = (0..n * f)
@@ -145,13 +142,13 @@ pub fn classical_fit(
     (secs, (1.0 - sse / sst) as f64)
 }
 
-/// Streaming latency of the CNN-BiLSTM, µs per new sample ([`crate::identify::Streamer::push`]:
+/// Streaming latency of the CNN-BiLSTM, µs per new sample ([`railforce::identify::Streamer::push`]:
 /// standardise, shift the window, one forward pass), over `samples` pushes.
 pub fn streaming_latency_us(samples: usize) -> f64 {
-    use crate::features::{LabelAt, NoiseProtocol, Split, ZScore};
-    use crate::learn::model::{Engine, Model, ModelKind, ModelMeta};
-    use crate::learn::windows::DataSpec;
-    let channels: Vec<String> = crate::sensors::PAPER_CHANNELS
+    use railforce::features::{LabelAt, NoiseProtocol, Split, ZScore};
+    use railforce::learn::model::{Engine, Model, ModelKind, ModelMeta};
+    use railforce::learn::windows::DataSpec;
+    let channels: Vec<String> = railforce::sensors::PAPER_CHANNELS
         .iter()
         .map(|c| c.to_string())
         .collect();
@@ -192,7 +189,7 @@ pub fn streaming_latency_us(samples: usize) -> f64 {
         },
         engine: Engine::Net(Box::new(net)),
     };
-    let mut st = crate::identify::Streamer::new(&mut model);
+    let mut st = railforce::identify::Streamer::new(&mut model);
     let row: Vec<f64> = (0..21).map(|k| (k as f64 * 0.3).sin()).collect();
     for i in 0..20 {
         st.push(i as f64 * 0.005, &row);

@@ -1,5 +1,9 @@
 //! `railforce bench …`: built-in benchmarks.
 
+mod contact;
+mod learn;
+mod simulate;
+
 use anyhow::Result;
 use clap::{Args, Subcommand};
 
@@ -55,7 +59,7 @@ enum What {
 pub fn run(args: BenchArgs) -> Result<()> {
     match args.what {
         What::Learn { seconds, rows } => {
-            use railforce::bench::learn;
+            use learn;
             use railforce::learn::neural::Architecture as A;
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench learn`");
@@ -134,7 +138,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             v.contact.table();
             let table_s = t0.elapsed().as_secs_f64();
             let tr = railforce::track::Track::load(&super::builtin::resolve(&track)?)?;
-            let b = railforce::bench::simulate::run(&v, &tr, speed_kmh / 3.6, seconds)?;
+            let b = simulate::run(&v, &tr, speed_kmh / 3.6, seconds)?;
             println!(
                 "simulation benchmark: {} on {}, {speed_kmh} km/h, {seconds} s, step {} ms, one thread",
                 v.name,
@@ -162,7 +166,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 eprintln!("warning: debug build; use `cargo run --release -- bench contact`");
             }
             let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&vehicle)?)?;
-            let b = railforce::bench::contact::run(&v, iterations);
+            let b = contact::run(&v, iterations);
             println!(
                 "contact benchmark ({}: {} on {}, one thread, 122.6 kN, 60 km/h)",
                 v.name,
