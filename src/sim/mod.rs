@@ -318,10 +318,14 @@ impl<'a> Simulation<'a> {
     }
 
     /// Along-track position of the vehicle centre, m: the mean of the wheelsets' positions,
-    /// which are brought up to date every step (the other bodies' only every few).
+    /// projected onto the track from their current places.
     pub fn centre_s(&self) -> f64 {
         let w = &self.vehicle.contact.wheelsets;
-        w.iter().map(|&b| self.body_s[b]).sum::<f64>() / w.len() as f64
+        // Projected from the current positions (the stored ones may be a step old).
+        w.iter()
+            .map(|&b| project(self.track, &self.states[b].position, self.body_s[b]))
+            .sum::<f64>()
+            / w.len() as f64
     }
 
     /// Track frame at each body (as of the last step).
