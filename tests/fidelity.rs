@@ -282,8 +282,18 @@ fn fidelity_checks_hold() {
     // in a curve depends on how the bogie's friction elements stuck, within 3 % (README).
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         let tol = if (k / 2) % 2 == 0 { 0.01 } else { 0.03 };
-        assert!((x.0 / y.0 - 1.0).abs() < tol, "wheel {k}: Y/Q rms {} vs {}", x.0, y.0);
-        assert!((x.1 / y.1 - 1.0).abs() < tol, "wheel {k}: Q sd {} vs {}", x.1, y.1);
+        assert!(
+            (x.0 / y.0 - 1.0).abs() < tol,
+            "wheel {k}: Y/Q rms {} vs {}",
+            x.0,
+            y.0
+        );
+        assert!(
+            (x.1 / y.1 - 1.0).abs() < tol,
+            "wheel {k}: Q sd {} vs {}",
+            x.1,
+            y.1
+        );
     }
     let s = fidelity::column(&base, "s_m").unwrap();
     assert!(fidelity::position_jitter(&s) < 1e-3);
