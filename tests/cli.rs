@@ -287,3 +287,25 @@ fn built_in_vehicles_and_tracks_work_from_an_empty_folder() {
     assert!(!ok && err.contains("--force"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The installed binary runs the demo from an empty folder: plan, vehicle and tracks come
+/// from the built-in copies (release: the demo trains for about a minute and a half).
+#[test]
+#[ignore = "long: the whole demo, run in release"]
+fn demo_runs_from_an_empty_folder() {
+    let dir = std::env::temp_dir().join(format!("railforce-demo-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+        .arg("demo")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("demo/index.html").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

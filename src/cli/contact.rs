@@ -75,9 +75,10 @@ pub struct ContactArgs {
     /// Yaw angle, mrad (+ turning left).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw_mrad: f64,
-    /// Vertical load per wheel, kN: the wheelset height is found at which each wheel carries it.
-    #[arg(long, default_value_t = 122.6)]
-    load_kn: f64,
+    /// Vertical load per wheel, kN: the wheelset height is found at which each wheel carries it
+    /// [default: the --vehicle's static wheel load, else 122.6].
+    #[arg(long)]
+    load_kn: Option<f64>,
     /// Wheelset roll relative to the rail plane, mrad, beyond the rigid roll at this shift.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     extra_roll_mrad: f64,
@@ -106,15 +107,20 @@ pub struct ContactArgs {
 }
 
 pub fn run(args: ContactArgs) -> Result<()> {
-    if !(args.load_kn > 0.0 && args.speed_kmh > 0.0 && args.mu > 0.0) {
-        bail!("--load-kn, --speed-kmh and --mu must be positive");
-    }
     let vehicle = match &args.vehicle {
         Some(p) => Some(railforce::vehicle::Vehicle::load(
             &super::builtin::resolve(p)?,
         )?),
         None => None,
     };
+    let load_kn = args.load_kn.unwrap_or_else(|| {
+        vehicle.as_ref().map_or(122.6, |v| {
+            v.mass() * railforce::GRAVITY / (2 * v.contact.wheelsets.len()) as f64 * 1e-3
+        })
+    });
+    if !(load_kn > 0.0 && args.speed_kmh > 0.0 && args.mu > 0.0) {
+        bail!("--load-kn, --speed-kmh and --mu must be positive");
+    }
     let (geo, model, mass) = match &vehicle {
         Some(v) => (
             v.contact.geometry.clone(),
@@ -192,7 +198,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
         ];
         let spin = args.spin.unwrap_or(speed / geo.nominal_radius);
         w.angular_velocity = [-spin * yaw.sin(), spin * yaw.cos(), args.yaw_rate];
-        w.height = height_for_load(&table, &model, &w, args.load_kn * 1e3);
+        w.height = height_for_load(&table, &model, &w, load_kn * 1e3);
         let f = evaluate(&table, &model, &w);
         let name = if side == Side::Left { "left" } else { "right" };
         for (j, p) in f.patches.iter().enumerate() {

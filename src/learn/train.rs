@@ -201,16 +201,16 @@ pub fn train(
                 dropout: opts.dropout,
                 seed: opts.seed,
             };
-            let (net, summary) = train_network(
-                config.clone(),
-                &prep.train,
-                refresher.as_ref(),
-                &prep.val,
+            let job = NetJob {
+                config: config.clone(),
+                train: &prep.train,
+                refresher: refresher.as_ref(),
+                val: &prep.val,
                 opts,
                 out,
-                &meta,
-                progress,
-            )?;
+                meta: &meta,
+            };
+            let (net, summary) = train_network(&job, progress)?;
             meta.slots = Some(net.params.slots.clone());
             meta.net = Some(config);
             meta.training = summary;
@@ -264,39 +264,68 @@ pub fn train(
     Ok(model)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn train_network(
+/// What one network training needs.
+struct NetJob<'a> {
     config: NetConfig,
-    train: &WindowSet,
-    refresher: Option<&NoiseRefresher>,
-    val: &WindowSet,
-    opts: &TrainOptions,
-    out: &Path,
-    meta: &ModelMeta,
-    progress: &mut dyn FnMut(Progress),
-) -> Result<(Network, serde_json::Value)> {
-    let mut net = Network::new(config.clone());
-    let mut adam = Adam::new(net.params.value.len(), opts.lr);
-    let fingerprint = crate::dataset::fnv1a(
-        serde_json::to_string(&(
-            &config,
-            &meta.data,
-            &meta.data_identity,
-            opts.batch,
-            opts.lr,
-            opts.windows_per_epoch,
-            opts.fresh_noise,
-        ))
-        .expect("serialises")
-        .as_bytes(),
-    );
-    let ck_path = out.join("checkpoint.json");
-    let log_path = out.join("train_log.jsonl");
-    let mut log: Vec<EpochLog> = Vec::new();
-    let mut best = net.params.value.clone();
-    let (mut best_val, mut best_epoch, mut bad, mut start) =
-        (f64::INFINITY, 0usize, 0usize, 0usize);
-    if opts.resume && ck_path.exists() {
+    train: &'a WindowSet,
+    refresher: Option<&'a NoiseRefresher>,
+    val: &'a WindowSet,
+    opts: &'a TrainOptions,
+    out: &'a Path,
+    meta: &'a ModelMeta,
+}
+
+/// Where a network's training stands: weights, optimiser, the best weights so far, the
+/// early-stopping counters and the epoch log — exactly what a checkpoint holds.
+struct Trainer {
+    net: Network,
+    adam: Adam,
+    best: Vec<f32>,
+    best_val: f64,
+    best_epoch: usize,
+    bad: usize,
+    start: usize,
+    log: Vec<EpochLog>,
+}
+
+impl Trainer {
+    fn new(config: &NetConfig, opts: &TrainOptions) -> Self {
+        let net = Network::new(config.clone());
+        let adam = Adam::new(net.params.value.len(), opts.lr);
+        let best = net.params.value.clone();
+        Trainer {
+            net,
+            adam,
+            best,
+            best_val: f64::INFINITY,
+            best_epoch: 0,
+            bad: 0,
+            start: 0,
+            log: Vec::new(),
+        }
+    }
+
+    /// Identifies the model, data and settings a checkpoint belongs to.
+    fn fingerprint(job: &NetJob) -> String {
+        let opts = job.opts;
+        crate::dataset::fnv1a(
+            serde_json::to_string(&(
+                &job.config,
+                &job.meta.data,
+                &job.meta.data_identity,
+                opts.batch,
+                opts.lr,
+                opts.windows_per_epoch,
+                opts.fresh_noise,
+            ))
+            .expect("serialises")
+            .as_bytes(),
+        )
+    }
+
+    /// Continues from the checkpoint in `out` (refused if it belongs to something else).
+    fn resume(&mut self, out: &Path, fingerprint: &str) -> Result<()> {
+        let ck_path = out.join("checkpoint.json");
         let text = crate::io::read_text(&ck_path)?;
         let ck: Checkpoint = serde_json::from_str(&text).map_err(|e| Error::Parse {
             file: ck_path.clone(),
@@ -309,38 +338,42 @@ fn train_network(
                 "the checkpoint belongs to another model, data set or setting; train without --resume or into another folder",
             ));
         }
-        net.params.value = read_weights(&out.join("checkpoint_weights.bin"))?;
-        best = read_weights(&out.join("checkpoint_best.bin"))?;
+        self.net.params.value = read_weights(&out.join("checkpoint_weights.bin"))?;
+        self.best = read_weights(&out.join("checkpoint_best.bin"))?;
         let mv = read_weights(&out.join("checkpoint_adam.bin"))?;
-        let n = net.params.value.len();
-        if best.len() != n || mv.len() != 2 * n {
+        let n = self.net.params.value.len();
+        if self.best.len() != n || mv.len() != 2 * n {
             return Err(Error::config(
                 &ck_path,
                 "weights",
                 "checkpoint files do not match the network",
             ));
         }
-        adam.m = mv[..n].to_vec();
-        adam.v = mv[n..].to_vec();
-        adam.t = ck.adam_t;
-        (best_val, best_epoch, bad, start) = (ck.best_val, ck.best_epoch, ck.bad_epochs, ck.epoch);
-        log = crate::io::read_text(&log_path)?
+        self.adam.m = mv[..n].to_vec();
+        self.adam.v = mv[n..].to_vec();
+        self.adam.t = ck.adam_t;
+        (self.best_val, self.best_epoch, self.bad, self.start) =
+            (ck.best_val, ck.best_epoch, ck.bad_epochs, ck.epoch);
+        self.log = crate::io::read_text(&out.join("train_log.jsonl"))?
             .lines()
             .filter_map(|l| serde_json::from_str::<EpochLog>(l).ok())
-            .filter(|e| e.epoch <= start)
+            .filter(|e| e.epoch <= self.start)
             .collect();
+        Ok(())
     }
-    let (mut x, mut y, mut dout) = (Vec::new(), Vec::new(), Vec::new());
-    let (vx, vy) = val.all();
-    let batch = opts.batch;
-    let mut stopped_early = false;
-    for epoch in start + 1..=opts.epochs {
-        if bad >= opts.patience {
-            stopped_early = true;
-            break;
-        }
-        let te = Instant::now();
-        let mut order: Vec<usize> = (0..train.len()).collect();
+
+    /// One pass over this epoch's shuffled (and capped) training windows, with fresh input
+    /// noise where asked; returns the mean training loss and the number of windows.
+    fn epoch(
+        &mut self,
+        epoch: usize,
+        job: &NetJob,
+        buffers: &mut (Vec<f32>, Vec<f32>, Vec<f32>),
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<(f64, usize)> {
+        let opts = job.opts;
+        let batch = opts.batch;
+        let mut order: Vec<usize> = (0..job.train.len()).collect();
         let mut rng =
             ChaCha8Rng::seed_from_u64(opts.seed.wrapping_mul(1_000_003).wrapping_add(epoch as u64));
         for i in (1..order.len()).rev() {
@@ -350,21 +383,24 @@ fn train_network(
         if let Some(cap) = opts.windows_per_epoch {
             order.truncate(cap.max(batch));
         }
-        net.reseed_dropout(opts.seed ^ (epoch as u64).wrapping_mul(0x9E37_79B9));
-        let fresh = refresher.map(|r| {
-            train.with_inputs(r.draw(opts.seed.wrapping_mul(7_919).wrapping_add(epoch as u64)))
+        self.net
+            .reseed_dropout(opts.seed ^ (epoch as u64).wrapping_mul(0x9E37_79B9));
+        let fresh = job.refresher.map(|r| {
+            job.train
+                .with_inputs(r.draw(opts.seed.wrapping_mul(7_919).wrapping_add(epoch as u64)))
         });
-        let train = fresh.as_ref().unwrap_or(train);
+        let train = fresh.as_ref().unwrap_or(job.train);
+        let (x, y, dout) = buffers;
         let batches = order.len().div_ceil(batch);
         let mut loss_sum = 0.0f64;
         for (bi, chunk) in order.chunks(batch).enumerate() {
-            train.gather(chunk, &mut x, &mut y);
-            net.params.zero_grad();
-            let pred = net.forward(&x, chunk.len(), true);
+            train.gather(chunk, x, y);
+            self.net.params.zero_grad();
+            let pred = self.net.forward(x, chunk.len(), true);
             dout.clear();
             let scale = 2.0 / y.len() as f32;
             let mut l = 0.0f64;
-            for (p, t) in pred.iter().zip(&y) {
+            for (p, t) in pred.iter().zip(y.iter()) {
                 let e = p - t;
                 l += (e * e) as f64;
                 dout.push(scale * e);
@@ -377,8 +413,8 @@ fn train_network(
                 )));
             }
             loss_sum += l * chunk.len() as f64;
-            net.backward(&x, &dout);
-            adam.step(&mut net.params);
+            self.net.backward(x, dout);
+            self.adam.step(&mut self.net.params);
             if bi % 16 == 0 || bi + 1 == batches {
                 progress(Progress::Batch {
                     epoch,
@@ -387,65 +423,115 @@ fn train_network(
                 });
             }
         }
-        let train_s = te.elapsed().as_secs_f64();
-        let vp = net.predict(&vx, val.len());
-        let vm = metrics(&vy, &vp, &meta.target_stats);
+        Ok((loss_sum / order.len() as f64, order.len()))
+    }
+
+    /// Validation loss and R² per output; keeps the best weights and counts the epochs
+    /// without improvement (early stopping).
+    fn validate(
+        &mut self,
+        epoch: usize,
+        job: &NetJob,
+        vx: &[f32],
+        vy: &[f32],
+    ) -> Result<(f64, Vec<f64>)> {
+        let vp = self.net.predict(vx, job.val.len());
+        let vm = metrics(vy, &vp, &job.meta.target_stats);
         let val_loss = vm.iter().map(|m| m.mse).sum::<f64>() / vm.len() as f64;
         if !val_loss.is_finite() {
             return Err(Error::Domain(format!(
                 "validation loss is {val_loss} at epoch {epoch}; lower --lr"
             )));
         }
-        if val_loss < best_val {
-            best_val = val_loss;
-            best_epoch = epoch;
-            best.clone_from(&net.params.value);
-            bad = 0;
+        if val_loss < self.best_val {
+            self.best_val = val_loss;
+            self.best_epoch = epoch;
+            self.best.clone_from(&self.net.params.value);
+            self.bad = 0;
         } else {
-            bad += 1;
+            self.bad += 1;
         }
-        let entry = EpochLog {
-            epoch,
-            train_loss: loss_sum / order.len() as f64,
-            val_loss,
-            val_r2: vm.iter().map(|m| m.r2).collect(),
-            windows_per_s: order.len() as f64 / train_s,
-            seconds: te.elapsed().as_secs_f64(),
-            best_epoch,
-        };
-        log.push(entry.clone());
-        // Checkpoint: weights, best weights, Adam moments, counters, log.
-        write_weights(&out.join("checkpoint_weights.bin"), &net.params.value)?;
-        write_weights(&out.join("checkpoint_best.bin"), &best)?;
-        let mut mv = adam.m.clone();
-        mv.extend_from_slice(&adam.v);
+        Ok((val_loss, vm.iter().map(|m| m.r2).collect()))
+    }
+
+    /// Checkpoint: weights, best weights, Adam moments, counters, log.
+    fn checkpoint(&self, out: &Path, epoch: usize, fingerprint: &str) -> Result<()> {
+        write_weights(&out.join("checkpoint_weights.bin"), &self.net.params.value)?;
+        write_weights(&out.join("checkpoint_best.bin"), &self.best)?;
+        let mut mv = self.adam.m.clone();
+        mv.extend_from_slice(&self.adam.v);
         write_weights(&out.join("checkpoint_adam.bin"), &mv)?;
-        let lines: String = log
+        let lines: String = self
+            .log
             .iter()
             .map(|e| serde_json::to_string(e).expect("log serialises") + "\n")
             .collect();
-        crate::io::write_atomic(&log_path, |w| w.write_all(lines.as_bytes()))?;
+        crate::io::write_atomic(&out.join("train_log.jsonl"), |w| {
+            w.write_all(lines.as_bytes())
+        })?;
         let ck = Checkpoint {
             epoch,
-            best_val,
-            best_epoch,
-            bad_epochs: bad,
-            adam_t: adam.t,
-            fingerprint: fingerprint.clone(),
+            best_val: self.best_val,
+            best_epoch: self.best_epoch,
+            bad_epochs: self.bad,
+            adam_t: self.adam.t,
+            fingerprint: fingerprint.to_string(),
         };
         let ckj = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");
-        crate::io::write_atomic(&ck_path, |w| w.write_all(ckj.as_bytes()))?;
+        crate::io::write_atomic(&out.join("checkpoint.json"), |w| {
+            w.write_all(ckj.as_bytes())
+        })
+    }
+}
+
+/// Trains a network: resume if asked, then epochs (train, validate, checkpoint) until the
+/// epoch limit or early stopping; the best weights are restored.
+fn train_network(
+    job: &NetJob,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(Network, serde_json::Value)> {
+    let opts = job.opts;
+    let mut t = Trainer::new(&job.config, opts);
+    let fingerprint = Trainer::fingerprint(job);
+    if opts.resume && job.out.join("checkpoint.json").exists() {
+        t.resume(job.out, &fingerprint)?;
+    }
+    let mut buffers = (Vec::new(), Vec::new(), Vec::new());
+    let (vx, vy) = job.val.all();
+    let mut stopped_early = false;
+    for epoch in t.start + 1..=opts.epochs {
+        if t.bad >= opts.patience {
+            stopped_early = true;
+            break;
+        }
+        let te = Instant::now();
+        let (train_loss, windows) = t.epoch(epoch, job, &mut buffers, progress)?;
+        let train_s = te.elapsed().as_secs_f64();
+        let (val_loss, val_r2) = t.validate(epoch, job, &vx, &vy)?;
+        let entry = EpochLog {
+            epoch,
+            train_loss,
+            val_loss,
+            val_r2,
+            windows_per_s: windows as f64 / train_s,
+            seconds: te.elapsed().as_secs_f64(),
+            best_epoch: t.best_epoch,
+        };
+        t.log.push(entry.clone());
+        t.checkpoint(job.out, epoch, &fingerprint)?;
         progress(Progress::Epoch(entry));
     }
-    net.params.value = best;
+    let mut net = t.net;
+    net.params.value = t.best;
+    let log = &t.log;
     let mean_rate = log.iter().map(|e| e.windows_per_s).sum::<f64>() / log.len().max(1) as f64;
     let summary = json!({
         "epochs_run": log.len(),
-        "best_epoch": best_epoch,
-        "best_val_loss": best_val,
-        "stopped_early": stopped_early || bad >= opts.patience,
-        "training_windows": train.len(),
-        "validation_windows": val.len(),
+        "best_epoch": t.best_epoch,
+        "best_val_loss": t.best_val,
+        "stopped_early": stopped_early || t.bad >= opts.patience,
+        "training_windows": job.train.len(),
+        "validation_windows": job.val.len(),
         "parameters": net.params.trainable_count(),
         "mean_windows_per_s": mean_rate,
     });
