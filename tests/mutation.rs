@@ -250,3 +250,93 @@ fn shard_manifest_without_runs_is_an_error() {
     assert!(railforce::dataset::merge(&dir).is_err());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A tiny data set and model, made with the binary, then its files mutated: the model
+/// directory's `model.json`, the data set's `manifest.json` and a run file (NPZ, bytes
+/// truncated or flipped) load or say why, never panic.
+#[test]
+fn model_and_data_set_files_parse_or_say_why() {
+    let dir = std::env::temp_dir().join(format!("railforce-mut-md-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let plan = dir.join("p.plan.toml");
+    std::fs::write(
+        &plan,
+        format!(
+            "name = \"p\"\nvehicle = \"{root}/vehicles/c80.toml\"\nduration_s = 0.4\nseeds = [1, 2, 3]\n\
+             [[condition]]\nname = \"tangent\"\ntrack = \"{root}/tracks/tangent.toml\"\nspeed_kmh = 60.0\n"
+        ),
+    )
+    .unwrap();
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let data = dir.join("data");
+    let model = dir.join("model");
+    run(&[
+        "generate",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--out",
+        data.to_str().unwrap(),
+        "--settle",
+        "0.1",
+    ]);
+    run(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        "tree",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    fuzz(
+        "model",
+        &model.join("model.json"),
+        &[&model.join("model.bin")],
+        |p| railforce::learn::model::Model::load(p.parent().unwrap()),
+    );
+    let files: Vec<PathBuf> = std::fs::read_dir(&data)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "npz"))
+        .collect();
+    let siblings: Vec<&Path> = files.iter().map(|p| p.as_path()).collect();
+    fuzz("manifest", &data.join("manifest.json"), &siblings, |p| {
+        railforce::features::DataSet::load(p.parent().unwrap())
+    });
+    // A run file, as bytes: truncated or a bit flipped.
+    let bytes = std::fs::read(&files[0]).unwrap();
+    let mut g = Gen(5);
+    for case in 0..CASES {
+        let mut b = bytes.clone();
+        if case % 2 == 0 {
+            b.truncate(g.random_range(0..b.len()));
+        } else {
+            let i = g.random_range(0..b.len());
+            b[i] ^= 1 << g.random_range(0..8);
+        }
+        std::fs::write(&files[0], &b).unwrap();
+        let r = std::panic::catch_unwind(|| railforce::features::read_table(&files[0]).map(|_| ()));
+        match r {
+            Err(_) => panic!("npz case {case}: the reader panicked"),
+            Ok(Err(e)) => assert!(
+                e.to_string()
+                    .contains(&*files[0].file_name().unwrap().to_string_lossy()),
+                "npz case {case}: {e}"
+            ),
+            Ok(Ok(())) => {}
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -160,6 +160,20 @@ impl Model {
                 .net
                 .clone()
                 .ok_or_else(|| Error::config(&path, "net", "missing for a network"))?;
+            // Sizes from the file: bounded before anything is allocated from them.
+            for (field, v, max) in [
+                ("net.window", config.window, 100_000),
+                ("net.channels", config.channels, 10_000),
+                ("net.outputs", config.outputs, 64),
+            ] {
+                if v == 0 || v > max {
+                    return Err(Error::config(
+                        &path,
+                        field,
+                        format!("{v} is outside 1..={max}"),
+                    ));
+                }
+            }
             let mut net = Network::new(config);
             if meta.slots.as_ref() != Some(&net.params.slots) {
                 return Err(Error::config(
