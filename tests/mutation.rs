@@ -315,27 +315,47 @@ fn model_and_data_set_files_parse_or_say_why() {
     fuzz("manifest", &data.join("manifest.json"), &siblings, |p| {
         railforce::features::DataSet::load(p.parent().unwrap())
     });
-    // A run file, as bytes: truncated or a bit flipped.
-    let bytes = std::fs::read(&files[0]).unwrap();
-    let mut g = Gen(5);
-    for case in 0..CASES {
-        let mut b = bytes.clone();
-        if case % 2 == 0 {
-            b.truncate(g.random_range(0..b.len()));
-        } else {
-            let i = g.random_range(0..b.len());
-            b[i] ^= 1 << g.random_range(0..8);
-        }
-        std::fs::write(&files[0], &b).unwrap();
-        let r = std::panic::catch_unwind(|| railforce::features::read_table(&files[0]).map(|_| ()));
-        match r {
-            Err(_) => panic!("npz case {case}: the reader panicked"),
-            Ok(Err(e)) => assert!(
-                e.to_string()
-                    .contains(&*files[0].file_name().unwrap().to_string_lossy()),
-                "npz case {case}: {e}"
-            ),
-            Ok(Ok(())) => {}
+    // Run files, as bytes (NPZ, and Parquet from a second data set): truncated or a bit flipped.
+    let pq = dir.join("pq");
+    run(&[
+        "generate",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--out",
+        pq.to_str().unwrap(),
+        "--settle",
+        "0.1",
+        "--format",
+        "parquet",
+    ]);
+    let parquet = std::fs::read_dir(&pq)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "parquet"))
+        .unwrap();
+    for file in [&files[0], &parquet] {
+        let bytes = std::fs::read(file).unwrap();
+        let mut g = Gen(5);
+        for case in 0..CASES {
+            let mut b = bytes.clone();
+            if case % 2 == 0 {
+                b.truncate(g.random_range(0..b.len()));
+            } else {
+                let i = g.random_range(0..b.len());
+                b[i] ^= 1 << g.random_range(0..8);
+            }
+            std::fs::write(file, &b).unwrap();
+            let r = std::panic::catch_unwind(|| railforce::features::read_table(file).map(|_| ()));
+            match r {
+                Err(_) => panic!("{} case {case}: the reader panicked", file.display()),
+                Ok(Err(e)) => assert!(
+                    e.to_string()
+                        .contains(&*file.file_name().unwrap().to_string_lossy()),
+                    "{} case {case}: {e}",
+                    file.display()
+                ),
+                Ok(Ok(())) => {}
+            }
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
