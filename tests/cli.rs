@@ -270,6 +270,9 @@ fn built_in_vehicles_and_tracks_work_from_an_empty_folder() {
     assert!(ok, "{out}\n{err}");
     assert!(err.contains("built-in"), "{err}");
     assert!(dir.join("run.csv").exists());
+    // A bare name stands for a built-in track, vehicle or plan.
+    let (ok, out, err) = run(&["track", "curve_r400"]);
+    assert!(ok && out.contains("R 400 m"), "{out}\n{err}");
     let (ok, out, err) = run(&["init", "mine"]);
     assert!(ok, "{err}");
     assert!(out.contains("wrote"), "{out}");

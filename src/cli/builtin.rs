@@ -144,6 +144,20 @@ pub fn resolve(path: &Path) -> Result<PathBuf> {
         return Ok(path.to_path_buf());
     }
     let rel = path.strip_prefix("./").unwrap_or(path);
+    // A bare name stands for a built-in plan or vehicle: `paper34`, `demo`, `c80_empty`.
+    let named = rel
+        .to_str()
+        .filter(|r| !r.contains('/') && !r.contains('.'))
+        .and_then(|n| {
+            [
+                format!("tracks/{n}.plan.toml"),
+                format!("vehicles/{n}.toml"),
+                format!("tracks/{n}.toml"),
+            ]
+            .into_iter()
+            .find(|c| FILES.iter().any(|(p, _)| p == c))
+        });
+    let rel = named.as_deref().map(Path::new).unwrap_or(rel);
     let Some(rel) = rel.to_str().filter(|r| FILES.iter().any(|(p, _)| p == r)) else {
         return Ok(path.to_path_buf());
     };
