@@ -125,6 +125,8 @@ pub struct Simulation<'a> {
     time: f64,
     /// Flange height of the wheel profile, m.
     flange_height: f64,
+    /// Nadal's limit for the flange angle in force (the config's, else the vehicle's).
+    nadal_limit: f64,
     /// Results of the last contact evaluation, per wheel (1L, 1R, 2L, …).
     pub wheels: Vec<WheelResult>,
     /// Accelerations of each body at the last step, world, m/s².
@@ -286,6 +288,11 @@ impl<'a> Simulation<'a> {
                     .fold(f64::MIN, f64::max)
                     - w.eval(0.0).0
             },
+            nadal_limit: SimConfig {
+                nadal_angle: Some(cfg.nadal_angle.unwrap_or(vehicle.contact.flange_angle)),
+                ..SimConfig::default()
+            }
+            .nadal_limit(vehicle.contact.friction),
             cfg,
             wheels: vec![WheelResult::default(); n_wheels],
             accelerations: vec![Vector3::zeros(); n],
@@ -459,15 +466,7 @@ impl<'a> Simulation<'a> {
                 )));
             }
         }
-        let limit = SimConfig {
-            nadal_angle: Some(
-                self.cfg
-                    .nadal_angle
-                    .unwrap_or(self.vehicle.contact.flange_angle),
-            ),
-            ..SimConfig::default()
-        }
-        .nadal_limit(self.vehicle.contact.friction);
+        let limit = self.nadal_limit;
         let flange = self.flange_height;
         for k in 0..self.wheels.len() {
             let w = &self.wheels[k];

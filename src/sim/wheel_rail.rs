@@ -59,48 +59,47 @@ impl Simulation<'_> {
         &self.inputs
     }
 
-    /// The state of wheel `k` (0 left, 1 right) of wheelset body `b` relative to its rail, as
-    /// the one contact evaluation ([`crate::contact::evaluate`]) takes it.
-    pub fn wheel_on_rail(&self, b: usize, k: usize) -> WheelOnRail {
+    /// Both wheels of the `w`-th wheelset relative to their rails, as the one contact
+    /// evaluation ([`crate::contact::evaluate`]) takes them (the wheelset's pose and motion in
+    /// its track frame computed once for both), and the wheelset centre's lateral position
+    /// relative to the track centre line, m.
+    fn wheels_on_rails(&self, w: usize) -> ([WheelOnRail; 2], f64) {
+        let b = self.vehicle.contact.wheelsets[w];
         let st = self.states[b];
         let f = self.frames[b];
         let rel = f.to_local(&(st.position - f.origin));
-        let rot_rel = f.axes.transpose() * st.matrix();
-        let axle = rot_rel.column(1);
-        let w = self
-            .vehicle
-            .contact
-            .wheelsets
-            .iter()
-            .position(|&x| x == b)
-            .unwrap_or(0);
-        let rail = self.rails[2 * w + k];
+        let axle = (f.axes.transpose() * st.matrix()).column(1).into_owned();
+        let (roll, yaw) = (axle.z.asin(), (-axle.x).atan2(axle.y));
+        let v = f.axes.transpose() * st.velocity;
+        let omega = f.axes.transpose() * st.angular_velocity;
         let r = f.rails();
-        let (side, irr_y, irr_z, y_ds, z_ds) = if k == 0 {
-            (Side::Left, r.left_y, r.left_z, r.left_y_ds, r.left_z_ds)
-        } else {
+        let sides = [
+            (Side::Left, r.left_y, r.left_z, r.left_y_ds, r.left_z_ds),
             (
                 Side::Right,
                 r.right_y,
                 r.right_z,
                 r.right_y_ds,
                 r.right_z_ds,
-            )
-        };
-        let v = f.axes.transpose() * st.velocity;
-        let omega = f.axes.transpose() * st.angular_velocity;
-        WheelOnRail {
-            side,
-            y: rel.y - irr_y - rail.y,
-            height: rel.z - irr_z - rail.z,
-            roll: axle.z.asin(),
-            yaw: (-axle.x).atan2(axle.y),
-            velocity: [v.x, v.y - rail.vy, v.z - rail.vz],
-            angular_velocity: [omega.x, omega.y, omega.z],
-            surface_rate: [v.x * y_ds, v.x * z_ds],
-            speed: v.x,
-            mass: 0.5 * self.vehicle.bodies[b].mass,
-        }
+            ),
+        ];
+        let wheels = std::array::from_fn(|k| {
+            let (side, irr_y, irr_z, y_ds, z_ds) = sides[k];
+            let rail = self.rails[2 * w + k];
+            WheelOnRail {
+                side,
+                y: rel.y - irr_y - rail.y,
+                height: rel.z - irr_z - rail.z,
+                roll,
+                yaw,
+                velocity: [v.x, v.y - rail.vy, v.z - rail.vz],
+                angular_velocity: [omega.x, omega.y, omega.z],
+                surface_rate: [v.x * y_ds, v.x * z_ds],
+                speed: v.x,
+                mass: 0.5 * self.vehicle.bodies[b].mass,
+            }
+        });
+        (wheels, rel.y)
     }
 
     pub(super) fn contact(&mut self) -> Result<()> {
@@ -108,11 +107,10 @@ impl Simulation<'_> {
         let cs = &v.contact;
         let model = cs.model();
         for (w, &b) in cs.wheelsets.iter().enumerate() {
-            let st = self.states[b];
             let f = self.frames[b];
-            for k in 0..2 {
+            let (inputs, y_centre) = self.wheels_on_rails(w);
+            for (k, wr) in inputs.into_iter().enumerate() {
                 let idx = 2 * w + k;
-                let wr = self.wheel_on_rail(b, k);
                 let out = evaluate(self.table, &model, &wr);
                 self.inputs[idx] = wr;
                 let force = f.axes * Vector3::from(out.force);
@@ -135,7 +133,7 @@ impl Simulation<'_> {
                         + lift,
                     yaw: wr.yaw,
                     roll: wr.roll,
-                    y_centre: f.to_local(&(st.position - f.origin)).y,
+                    y_centre,
                     rail_slope: if k == 0 {
                         rails.left_y_ds
                     } else {

@@ -101,16 +101,6 @@ struct SensorsFile {
     label_wheel: String,
 }
 
-fn b_find(
-    path: &Path,
-    urdf: &Path,
-    bodies: &[super::Body],
-    field: String,
-    name: &str,
-) -> Result<usize> {
-    Binder { path, urdf, bodies }.find(field, name)
-}
-
 /// Reads a vehicle TOML file and the URDF it names, validates everything and computes the
 /// static preloads of the supporting elements from the load path.
 pub(super) fn load(path: &Path) -> Result<Vehicle> {
@@ -119,25 +109,15 @@ pub(super) fn load(path: &Path) -> Result<Vehicle> {
     let urdf_path = dir.join(&raw.urdf);
     let bodies = super::urdf::read_urdf(&urdf_path)?;
     let cfg = |field: String, msg: String| Error::config(path, field, msg);
-    let find = |field: String, name: &str| b_find(path, &urdf_path, &bodies, field, name);
-    let non_negative = |field: String, values: &[f64]| -> Result<()> {
-        if let Some(v) = values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-            return Err(cfg(field, format!("must not be negative, got {v}")));
-        }
-        Ok(())
-    };
-    let positive = |field: String, v: f64| -> Result<f64> {
-        if v.is_finite() && v > 0.0 {
-            Ok(v)
-        } else {
-            Err(cfg(field, format!("must be positive, got {v}")))
-        }
-    };
+    // One binder for the whole file: the elements bind through it, and so does the rest.
     let b = Binder {
         path,
         urdf: &urdf_path,
         bodies: &bodies,
     };
+    let find = |field: String, name: &str| b.find(field, name);
+    let non_negative = |field: String, values: &[f64]| b.non_negative(field, values);
+    let positive = |field: String, v: f64| b.positive(field, v);
     let mut elements = Vec::new();
     for (i, e) in raw.shear_pad.iter().enumerate() {
         elements.push(Element::ShearPad(ShearPad::bind(
