@@ -45,7 +45,7 @@ fn every_experiment_runs_end_to_end() {
     std::fs::create_dir_all(&dir).unwrap();
     let opts = ExperimentOptions {
         models: vec![ModelKind::CnnBiLstm, ModelKind::Gru, ModelKind::Tree],
-        robustness_models: vec![ModelKind::Tree, ModelKind::Gru],
+        robustness_models: vec![ModelKind::Tree, ModelKind::Cnn],
         snrs: vec![40.0, 1.0],
         loco: vec!["curve_r400_v60".into()],
         window: 12,
@@ -68,7 +68,7 @@ fn every_experiment_runs_end_to_end() {
     };
     assert_eq!(
         header("comparison/comparison_fl.csv"),
-        "model,train MSE,train R²,test MSE,test R²,Var(y_test),test RMSE kN,fit s,paper train MSE / R²,paper test MSE / R²"
+        "model,train_mse,train_r2,test_mse,test_r2,var_y_test,test_rmse_kn,fit_s,paper_train_mse,paper_train_r2,paper_test_mse,paper_test_r2"
     );
     assert_eq!(
         std::fs::read_to_string(out.join("comparison/comparison_fq.csv"))
@@ -77,14 +77,13 @@ fn every_experiment_runs_end_to_end() {
             .count(),
         4
     );
-    assert!(
-        header("generalization/per_condition.csv")
-            .starts_with("condition,FL MSE,FL R²,FQ MSE,FQ R²")
-    );
-    assert!(header("generalization/leave_one_out.csv").starts_with("held-out condition,"));
+    assert!(header("generalization/per_condition.csv").starts_with(
+        "condition,n,fl_mse,fl_r2,var_fl_test,fq_mse,fq_r2,var_fq_test,paper_fq_mse,paper_fq_r2"
+    ));
+    assert!(header("generalization/leave_one_out.csv").starts_with("held_out_condition,"));
     assert_eq!(
         header("robustness/robustness.csv"),
-        "protocol,SNR dB,model,FL MSE,FL R²,FQ MSE,FQ R²,paper R² at 1 dB"
+        "protocol,snr_db,model,fl_mse,fl_r2,fq_mse,fq_r2,paper_r2_at_1_db"
     );
     // 2 protocols × 2 models × 2 SNRs.
     assert_eq!(
@@ -94,19 +93,25 @@ fn every_experiment_runs_end_to_end() {
             .count(),
         9
     );
-    let html = std::fs::read_to_string(&index).unwrap();
-    let mut links = 0;
-    for attr in ["href=\"", "src=\""] {
-        for part in html.split(attr).skip(1) {
-            let target = part.split('"').next().unwrap();
-            assert!(
-                out.join(target).is_file(),
-                "index.html links {target}, which does not exist"
-            );
-            links += 1;
-        }
+    check_links(&index, &out, 12);
+    // Charts a reader reads at a glance: names on the axis, the paper's values beside ours.
+    let bars = std::fs::read_to_string(out.join("generalization/r2_per_condition.svg")).unwrap();
+    for name in ["tangent_v80", "curve_r400_v60", "grade20_L50_v60"] {
+        assert!(
+            bars.contains(name),
+            "{name} missing from the per-condition chart"
+        );
     }
-    assert!(links >= 12, "{links} links");
+    // The paper's FQ R² of curve_r400_v60 (Table 4: 0.9301).
+    assert!(bars.contains("FQ (paper): 0.93<"), "paper's value missing");
+    let models = std::fs::read_to_string(out.join("comparison/r2_per_model_fl.svg")).unwrap();
+    assert!(models.contains("cnn-bilstm") && models.contains("paper: 0.813<"));
+    let snr = std::fs::read_to_string(out.join("robustness/r2_vs_snr_fl_matched.svg")).unwrap();
+    assert!(
+        snr.contains("paper cnn (1 dB): 1, 0.657"),
+        "the paper's point"
+    );
+    let html = std::fs::read_to_string(&index).unwrap();
     for svg in [
         "comparison/training_curves_fl.svg",
         "comparison/trace_fq.svg",
@@ -117,9 +122,7 @@ fn every_experiment_runs_end_to_end() {
     }
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("meta.json")).unwrap()).unwrap();
-    assert!(
-        meta["data_manifest_fnv1a"].is_string() && meta["wall_seconds"].as_f64().unwrap() > 0.0
-    );
+    assert!(meta["data_fnv1a"].is_string() && meta["wall_seconds"].as_f64().unwrap() > 0.0);
     assert_eq!(meta["window"], 12);
     assert_eq!(meta["label_at"], "Centre");
     assert_eq!(meta["noise"]["reference"], "std");
@@ -129,7 +132,54 @@ fn every_experiment_runs_end_to_end() {
     assert_eq!(protocols.lines().count(), 5);
     let sensors = std::fs::read_to_string(out.join("sensors/sensors.csv")).unwrap();
     assert!(sensors.contains("selected on-board") && sensors.contains("paper's 21"));
-    assert!(header("sensors/selection_fq.csv").starts_with("channel,MI nats"));
+    assert!(header("sensors/selection_fq.csv").starts_with("channel,mi_nats"));
     assert!(html.contains("label at the centre step"));
     assert!(html.contains("windows of 12 steps"));
+    let data = meta["data_fnv1a"].clone();
+
+    // One part run again on its own into the same folder: the report still shows all five,
+    // and the data identity is unchanged (nothing was regenerated).
+    let again = ExperimentOptions {
+        robustness_models: vec![ModelKind::Tree],
+        ..opts.clone()
+    };
+    run(&[Which::Robustness], &again, &|_| {}).unwrap();
+    let html = check_links(&index, &out, 12);
+    for part in [
+        "comparison",
+        "generalization",
+        "robustness",
+        "protocols",
+        "sensors",
+    ] {
+        assert!(
+            html.contains(&format!("id=\"{part}\"")),
+            "{part} missing after a rerun"
+        );
+    }
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["data_fnv1a"], data);
+    assert!(!html.contains("computed on different data"));
+}
+
+/// Every link of an index resolves to a file; returns the page.
+fn check_links(index: &Path, out: &Path, at_least: usize) -> String {
+    let html = std::fs::read_to_string(index).unwrap();
+    let mut links = 0;
+    for attr in ["href=\"", "src=\""] {
+        for part in html.split(attr).skip(1) {
+            let target = part.split('"').next().unwrap();
+            if target.starts_with('#') {
+                continue;
+            }
+            assert!(
+                out.join(target).is_file(),
+                "index.html links {target}, which does not exist"
+            );
+            links += 1;
+        }
+    }
+    assert!(links >= at_least, "{links} links");
+    html
 }

@@ -99,11 +99,12 @@ pub struct TrainArgs {
     /// Continue from the checkpoint in --out (same data and settings).
     #[arg(long)]
     resume: bool,
-    /// Networks, matched protocol: draw new training-input noise every epoch at the data
-    /// set's SNR (its manifest's `snr_db`) instead of learning one fixed noise realisation;
-    /// validation and test keep the data set's noisy columns.
+    /// Networks, matched protocol: learn the data set's one fixed noise realisation instead of
+    /// drawing new training-input noise every epoch at its SNR (the default, the spec's and
+    /// the experiments' protocol; validation and test always keep the data set's noisy
+    /// columns).
     #[arg(long)]
-    fresh_noise: bool,
+    fixed_noise: bool,
 }
 
 /// Resolves the data options into a [`DataSpec`].
@@ -273,38 +274,103 @@ pub fn run(args: TrainArgs) -> Result<()> {
         windows_per_epoch: args.windows_per_epoch,
         classical_rows: args.classical_rows,
         resume: args.resume,
-        fresh_noise: if args.fresh_noise {
-            Some(ds.noise.with_context(|| {
-                format!(
-                    "--fresh-noise: {}/manifest.json records no snr_db (generate with --snr-db)",
-                    args.data.data.display()
-                )
-            })?)
+        // Fresh noise applies to networks under the matched protocol when the data set
+        // records its noise; otherwise the one realisation on disk is all there is.
+        fresh_noise: if !args.fixed_noise
+            && kind.architecture().is_some()
+            && spec.noise == NoiseProtocol::Matched
+        {
+            ds.noise
         } else {
             None
         },
         ..TrainOptions::default()
     };
+    let short = |t: &String| target_name(t, &ds.labels);
     println!(
-        "training {} on {} ({} runs): {} channels × {} steps → {}; noise {:?}{}; split {}",
+        "training {} on {} ({} runs): {} channels × {} steps, label at the {} → {}",
         kind.name(),
         args.data.data.display(),
         ds.runs.len(),
         spec.channels.len(),
         spec.window,
-        spec.targets.join(" + "),
-        spec.noise,
-        spec.noise_model
-            .map(|n| format!(" at {} dB (σ from the {})", n.snr_db, n.reference.name()))
-            .unwrap_or_default(),
-        spec.split.describe()
+        match spec.label_at {
+            LabelAt::Centre => "centre step",
+            LabelAt::Last => "last step",
+        },
+        spec.targets
+            .iter()
+            .map(short)
+            .collect::<Vec<_>>()
+            .join(" and "),
     );
+    println!(
+        "  noise: {}{}",
+        spec.noise.describe(),
+        spec.noise_model
+            .map(|n| format!(", {}", n.describe()))
+            .unwrap_or_default()
+    );
+    if kind.architecture().is_some() && spec.noise == NoiseProtocol::Matched {
+        println!(
+            "  training noise: {}",
+            if opts.fresh_noise.is_some() {
+                "a new draw every epoch (the spec's protocol; --fixed-noise to learn the data set's one realisation)"
+            } else {
+                "the data set's one fixed realisation"
+            }
+        );
+    }
+    println!("  split: {}", spec.split.describe());
+    if kind.architecture().is_some() {
+        println!(
+            "  Adam lr {}, batch {}, at most {} epochs, patience {}, {} training windows per epoch",
+            opts.lr,
+            opts.batch,
+            opts.epochs,
+            opts.patience,
+            opts.windows_per_epoch
+                .map(|w| w.to_string())
+                .unwrap_or("all".into())
+        );
+    } else {
+        println!(
+            "  fitted on at most {} training windows (evenly strided)",
+            opts.classical_rows
+        );
+    }
     let model = train_with_bar(&ds, &spec, kind, &opts, &args.out)?;
     let t = &model.meta.training;
+    let r2 = t["best_val_r2"]
+        .as_array()
+        .or(t["val_r2"].as_array())
+        .map(|a| {
+            spec.targets
+                .iter()
+                .zip(a)
+                .map(|(n, v)| format!("{} {:.3}", short(n), v.as_f64().unwrap_or(f64::NAN)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .unwrap_or_default();
+    let how = if kind.architecture().is_some() {
+        format!(
+            "best epoch {} of {}{}",
+            t["best_epoch"],
+            t["epochs_run"],
+            if t["stopped_early"].as_bool() == Some(true) {
+                " (stopped early)"
+            } else {
+                ""
+            }
+        )
+    } else {
+        format!("fitted on {} windows", t["fitted_rows"])
+    };
     println!(
-        "model written to {}: {}",
-        args.out.display(),
-        serde_json::to_string(t)?
+        "done in {:.0} s: {how}; validation R² {r2}. Model in {} (model.json holds every setting).",
+        t["wall_seconds"].as_f64().unwrap_or(0.0),
+        args.out.display()
     );
     println!(
         "next: railforce evaluate --model {} --data {}",
@@ -312,6 +378,15 @@ pub fn run(args: TrainArgs) -> Result<()> {
         args.data.data.display()
     );
     Ok(())
+}
+
+/// `FL` or `FQ` for the data set's two labels, else the channel's own name.
+fn target_name(t: &str, labels: &[String]) -> String {
+    match labels.iter().position(|l| l == t) {
+        Some(0) => "FL".into(),
+        Some(1) => "FQ".into(),
+        _ => t.to_string(),
+    }
 }
 
 /// Trains with a progress bar on standard error and one line per epoch.
@@ -334,14 +409,19 @@ pub fn train_with_bar(
             bar.set_message(format!("epoch {epoch} batches"));
         }
         Progress::Epoch(e) => {
-            let r2: Vec<String> = e.val_r2.iter().map(|r| format!("{r:.3}")).collect();
+            let r2: Vec<String> = e
+                .val_r2
+                .iter()
+                .zip(&spec.targets)
+                .map(|(r, t)| format!("{} {r:.3}", target_name(t, &ds.labels)))
+                .collect();
             bar.suspend(|| {
                 eprintln!(
-                    "epoch {:>3}: train {:.4}  val {:.4}  val R² {}  {:.0} windows/s  best {}",
+                    "epoch {:>3}: loss train {:.4}, val {:.4}; val R² {}; {:.0} windows/s; best epoch {}",
                     e.epoch,
                     e.train_loss,
                     e.val_loss,
-                    r2.join("/"),
+                    r2.join(", "),
                     e.windows_per_s,
                     e.best_epoch
                 )
@@ -372,6 +452,10 @@ pub struct EvaluateArgs {
     /// Predictions CSV (default: MODEL/predictions.csv).
     #[arg(long)]
     predictions: Option<PathBuf>,
+    /// Per-condition metrics CSV, one row per condition and target, then the pooled rows
+    /// (default: MODEL/metrics_per_condition.csv).
+    #[arg(long)]
+    metrics: Option<PathBuf>,
 }
 
 pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
@@ -389,7 +473,7 @@ pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
     };
     let ev = evaluate(&mut model, &ds, part)?;
     println!(
-        "{} on {} ({}, noise {:?}), {} windows, {:.0} windows/s:",
+        "{} on {} ({}; {}), {} windows, {:.0} windows/s:",
         model.meta.kind.name(),
         args.data.display(),
         if args.all {
@@ -397,20 +481,45 @@ pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
         } else {
             format!("test part: {}", model.meta.data.split.describe())
         },
-        model.meta.data.noise,
+        model.meta.data.noise.describe(),
         ev.metrics.first().map(|m| m.n).unwrap_or(0),
         ev.windows_per_s
     );
+    let per = ev.per_condition(&model.meta.target_stats);
     println!(
-        "{:<14} {:>9} {:>9} {:>9} {:>10} {:>9}",
-        "target", "MSE", "R²", "Var(y)", "RMSE kN", "MAE kN"
+        "{:<24} {:<14} {:>8} {:>9} {:>9} {:>9} {:>10} {:>9}",
+        "condition", "target", "windows", "MSE", "R²", "Var(y)", "RMSE kN", "MAE kN"
     );
-    for m in &ev.metrics {
-        println!(
-            "{:<14} {:>9.4} {:>9.4} {:>9.4} {:>10.3} {:>9.3}",
-            m.target, m.mse, m.r2, m.var_y, m.rmse_kn, m.mae_kn
-        );
+    let all = ("all (pooled)".to_string(), ev.metrics.clone());
+    for (c, ms) in per.iter().chain(std::iter::once(&all)) {
+        for m in ms {
+            println!(
+                "{:<24} {:<14} {:>8} {:>9.4} {:>9.4} {:>9.4} {:>10.3} {:>9.3}",
+                c, m.target, m.n, m.mse, m.r2, m.var_y, m.rmse_kn, m.mae_kn
+            );
+        }
     }
+    let summary: Vec<String> = ev
+        .metrics
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let worst = railforce::learn::evaluate::Evaluation::worst_condition(&per, k)
+                .map(|(c, r2)| format!(", worst {c} {r2:.3}"))
+                .unwrap_or_default();
+            format!("{} R² {:.3} pooled{worst}", m.target, m.r2)
+        })
+        .collect();
+    println!(
+        "summary over {} condition(s): {}",
+        per.len(),
+        summary.join("; ")
+    );
+    let metrics_csv = args
+        .metrics
+        .unwrap_or_else(|| args.model.join("metrics_per_condition.csv"));
+    ev.write_condition_csv(&metrics_csv, &per)?;
+    println!("per-condition metrics: {}", metrics_csv.display());
     let out = args
         .predictions
         .unwrap_or_else(|| args.model.join("predictions.csv"));

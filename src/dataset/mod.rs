@@ -112,6 +112,38 @@ pub fn fnv1a(bytes: &[u8]) -> String {
     format!("{h:016x}")
 }
 
+/// Identity of a data set's contents: FNV-1a 64 over every run file's name and the hash of its
+/// bytes as `manifest.json` records them, in name order. Wall times, tool versions and the
+/// order runs finished in are left out, so a rerun that changes no data keeps the identity
+/// and any changed byte of any run changes it.
+pub fn data_identity(dir: &Path) -> Result<String> {
+    let path = dir.join("manifest.json");
+    let m = read_manifest(&path)?
+        .ok_or_else(|| Error::io(&path, std::io::ErrorKind::NotFound.into()))?;
+    let mut runs: Vec<(String, String)> = m["runs"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .map(|r| {
+                    (
+                        r["file"].as_str().unwrap_or_default().to_string(),
+                        r["bytes_hash_fnv1a"]
+                            .as_str()
+                            .unwrap_or_default()
+                            .to_string(),
+                    )
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    if runs.is_empty() {
+        return Err(Error::config(&path, "runs", "the manifest lists no runs"));
+    }
+    runs.sort();
+    let text: String = runs.iter().map(|(f, h)| format!("{f}:{h}\n")).collect();
+    Ok(fnv1a(text.as_bytes()))
+}
+
 /// FNV-1a 64 of a file's bytes, hex: identifies the inputs of a run.
 pub fn file_hash(path: &Path) -> Result<String> {
     Ok(fnv1a(&std::fs::read(path).map_err(|e| Error::io(path, e))?))

@@ -8,8 +8,8 @@ use crate::features::NoiseProtocol;
 use crate::learn::evaluate::{EvalPart, PredictionRow, evaluate};
 use crate::learn::model::ModelKind;
 use crate::report::Section;
-use crate::report::svg::{Chart, Series};
-use crate::report::table::Table;
+use crate::report::svg::{BarChart, BarSeries, Chart, Series, WIDTH};
+use crate::report::table::{MISSING, Table};
 
 pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let opts = ctx.opts;
@@ -27,12 +27,16 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             "Var(y_test)",
             "test RMSE kN",
             "fit s",
-            "paper train MSE / R²",
-            "paper test MSE / R²",
+            "paper train MSE",
+            "paper train R²",
+            "paper test MSE",
+            "paper test R²",
         ])
     });
     let mut curves: [Vec<Series>; 2] = [Vec::new(), Vec::new()];
-    let mut traces: [Option<Vec<PredictionRow>>; 2] = [None, None];
+    let mut traces: [Option<(ModelKind, Vec<PredictionRow>)>; 2] = [None, None];
+    // Test R² of ours and the paper's per model, per target (the bar chart).
+    let mut r2_bars: [[Vec<Option<f64>>; 2]; 2] = Default::default();
     let labels = ctx.labels();
     let mut jobs = Vec::new();
     for &kind in &opts.models {
@@ -68,14 +72,11 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             let p = paper::COMPARISON
                 .iter()
                 .find(|(n, _)| *n == kind.name())
-                .map(|(_, v)| {
-                    (
-                        format!("{} / {}", v[4 * k], v[4 * k + 1]),
-                        format!("{} / {}", v[4 * k + 2], v[4 * k + 3]),
-                    )
-                });
-            let (pa, pb) = p.unwrap_or_default();
+                .map(|(_, v)| [v[4 * k], v[4 * k + 1], v[4 * k + 2], v[4 * k + 3]]);
+            let pv = |i: usize| p.map(|p| p[i].to_string()).unwrap_or(MISSING.into());
             let m = &te.metrics[0];
+            r2_bars[k][0].push(Some(m.r2));
+            r2_bars[k][1].push(p.map(|p| p[3]));
             tables[k].push(vec![
                 kind.name().into(),
                 f4(tr[0].mse),
@@ -85,22 +86,24 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 f4(m.var_y),
                 format!("{:.2}", m.rmse_kn),
                 format!("{secs:.1}"),
-                pa,
-                pb,
+                pv(0),
+                pv(1),
+                pv(2),
+                pv(3),
             ]);
             if kind.architecture().is_some() {
-                curves[k].push(Series {
-                    label: kind.name().into(),
-                    points: read_log(mdir)
+                curves[k].push(Series::line(
+                    kind.name(),
+                    read_log(mdir)
                         .iter()
                         .map(|e| (e.epoch as f64, e.val_loss))
                         .collect(),
-                });
+                ));
             }
             if kind == ModelKind::CnnBiLstm
                 || (traces[k].is_none() && kind == *opts.models.last().expect("models"))
             {
-                traces[k] = Some(te.rows.clone());
+                traces[k] = Some((kind, te.rows.clone()));
             }
         }
     }
@@ -133,51 +136,92 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         ],
         figures: Vec::new(),
     };
+    let model_names: Vec<String> = jobs
+        .iter()
+        .step_by(2)
+        .map(|j| j.kind.name().to_string())
+        .collect();
     for (k, name) in [(0, "FL"), (1, "FQ")] {
+        let [ours, theirs] = std::mem::take(&mut r2_bars[k]);
+        sec.figures.push((
+            format!(
+                "{name}: test R² of every model, ours beside the paper's (Table {})",
+                2 + k
+            ),
+            BarChart {
+                title: format!(
+                    "{name} test R² per model, {} at {} dB",
+                    opts.condition, opts.snr_db
+                ),
+                y_label: format!("test R², {name}"),
+                categories: model_names.clone(),
+                series: vec![
+                    BarSeries {
+                        label: "ours".into(),
+                        values: ours,
+                    },
+                    BarSeries {
+                        label: "paper".into(),
+                        values: theirs,
+                    },
+                ],
+                floor: None,
+                width: WIDTH,
+            }
+            .into(),
+            format!("r2_per_model_{}.svg", name.to_lowercase()),
+        ));
         let series = std::mem::take(&mut curves[k]);
         if !series.is_empty() {
             sec.figures.push((
-                format!("{name}: validation MSE per epoch"),
-                Chart {
-                    title: format!("Validation loss, {name}"),
-                    x_label: "epoch".into(),
-                    y_label: "MSE (standardised)".into(),
-                    log_x: false,
-                    y_range: None,
+                format!("{name}: validation MSE per epoch of the networks"),
+                Chart::new(
+                    format!("Validation loss, {name}"),
+                    "epoch",
+                    "MSE (standardised)",
                     series,
-                },
+                )
+                .into(),
                 format!("training_curves_{}.svg", name.to_lowercase()),
             ));
         }
-        if let Some(rows) = &traces[k] {
+        if let Some((kind, rows)) = &traces[k] {
             let first = rows.first().map(|r| (r.0.clone(), r.1));
             let run: Vec<&PredictionRow> = rows
                 .iter()
                 .filter(|r| Some((r.0.clone(), r.1)) == first)
                 .collect();
-            let step = run.len().div_ceil(1500).max(1);
+            let step = run.len().div_ceil(3000).max(1);
             let pts: Vec<&PredictionRow> = run.iter().step_by(step).copied().collect();
+            let span = (
+                pts.first().map_or(0.0, |r| r.2),
+                pts.last().map_or(0.0, |r| r.2),
+            );
             let series = vec![
-                Series {
-                    label: "true".into(),
-                    points: pts.iter().map(|r| (r.2, r.3[0].0 / 1000.0)).collect(),
-                },
-                Series {
-                    label: "identified".into(),
-                    points: pts.iter().map(|r| (r.2, r.3[0].1 / 1000.0)).collect(),
-                },
+                Series::line(
+                    "true",
+                    pts.iter().map(|r| (r.2, r.3[0].0 / 1000.0)).collect(),
+                ),
+                Series::line(
+                    format!("{} (identified)", kind.name()),
+                    pts.iter().map(|r| (r.2, r.3[0].1 / 1000.0)).collect(),
+                ),
             ];
             let seed = first.map(|f| f.1).unwrap_or(0);
             sec.figures.push((
-                format!("{name}: identified against true force over the whole test run (seed {seed}, never seen in training)"),
-                Chart {
-                    title: format!("{name}, test run seed {seed}"),
-                    x_label: "time (s)".into(),
-                    y_label: "force (kN)".into(),
-                    log_x: false,
-                    y_range: None,
+                format!(
+                    "{name}: {} against the true force over the whole test run ({:.1}–{:.1} s, seed {seed}, never seen in training)",
+                    kind.name(),
+                    span.0,
+                    span.1
+                ),
+                Chart::new(
+                    format!("{name}, {}: identified and true, test run seed {seed}", kind.name()),
+                    "time (s)",
+                    "force (kN)",
                     series,
-                },
+                )
+                .into(),
                 format!("trace_{}.svg", name.to_lowercase()),
             ));
         }

@@ -17,13 +17,12 @@ mod sensors;
 use crate::dataset::{Format, GenerateOptions, generate};
 use crate::error::{Error, Result};
 use crate::features::{DataSet, LabelAt, NoiseProtocol, Split};
-use crate::learn::evaluate::PredictionRow;
 use crate::learn::metrics::{Metrics, metrics};
 use crate::learn::model::{Model, ModelKind};
 use crate::learn::train::{EpochLog, Progress, TrainOptions, train};
 use crate::learn::windows::{DataSpec, prepare};
 use crate::plan::Plan;
-use crate::report::{Section, write_index};
+use crate::report::write_index;
 use crate::sensors::{Candidates, NoiseModel, PAPER_CHANNELS, SnrReference};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -58,6 +57,15 @@ impl Which {
             w => vec![w],
         }
     }
+
+    /// Every experiment's folder, in report order.
+    pub const FOLDERS: [&'static str; 5] = [
+        "comparison",
+        "generalization",
+        "robustness",
+        "protocols",
+        "sensors",
+    ];
 
     fn folder(self) -> &'static str {
         match self {
@@ -338,30 +346,6 @@ fn train_metrics(model: &mut Model, ds: &DataSet) -> Result<Vec<Metrics>> {
     Ok(metrics(&y, &p, &stats.1))
 }
 
-/// Per target, (MSE, R², Var(y)) in standardised units over the rows of one condition.
-fn per_condition(rows: &[PredictionRow], model: &Model, condition: &str) -> Vec<(f64, f64, f64)> {
-    let ts = &model.meta.target_stats;
-    (0..ts.mean.len())
-        .map(|k| {
-            let pts: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|r| r.0 == condition)
-                .map(|r| {
-                    (
-                        (r.3[k].0 - ts.mean[k]) / ts.std[k],
-                        (r.3[k].1 - ts.mean[k]) / ts.std[k],
-                    )
-                })
-                .collect();
-            let n = pts.len().max(1) as f64;
-            let mean = pts.iter().map(|p| p.0).sum::<f64>() / n;
-            let sst: f64 = pts.iter().map(|p| (p.0 - mean).powi(2)).sum();
-            let sse: f64 = pts.iter().map(|p| (p.0 - p.1).powi(2)).sum();
-            (sse / n, 1.0 - sse / sst, sst / n)
-        })
-        .collect()
-}
-
 fn f4(v: f64) -> String {
     format!("{v:.4}")
 }
@@ -374,6 +358,78 @@ fn read_log(dir: &Path) -> Vec<EpochLog> {
                 .collect()
         })
         .unwrap_or_default()
+}
+
+/// Rebuilds `index.html` of an experiments folder from every part present (each part's
+/// `section.json` and `meta.json`), whichever order and run they came from; the intro states
+/// the protocol of the latest run and warns when parts were computed on different data.
+pub fn write_report(out: &Path) -> Result<PathBuf> {
+    let read = |p: PathBuf| -> Option<serde_json::Value> {
+        crate::io::read_text(&p)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+    };
+    let meta = read(out.join("meta.json")).unwrap_or_default();
+    let s = |k: &str| meta[k].as_str().unwrap_or("?").to_string();
+    let mut intro = vec![
+        format!(
+            "Latest run: railforce {}, plan {} ({} runs, data {}); noise: {}; split: {}; windows of {} steps, label {}.",
+            s("railforce_version"),
+            s("plan_name"),
+            meta["runs"].as_u64().unwrap_or(0),
+            s("data_fnv1a"),
+            s("noise_definition"),
+            s("split_description"),
+            meta["window"].as_u64().unwrap_or(0),
+            s("label_at").to_lowercase(),
+        ),
+        "Paper numbers come from another simulator and an unstated (apparently shuffled) split: a bar, not a target to match digit for digit. Each part below states its own protocol and the data it was computed on.".into(),
+    ];
+    let t = &meta["training"];
+    let count = |v: &serde_json::Value| v.as_u64().map_or("all".to_string(), |n| n.to_string());
+    if t.is_object() {
+        intro.push(format!(
+            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch ({} on one condition), validation on at most {} windows{}; classical models on at most {} windows.",
+            t["lr"],
+            t["batch"],
+            t["epochs"],
+            t["patience"],
+            count(&t["windows_per_epoch"]),
+            count(&meta["condition_windows_per_epoch"]),
+            count(&t["val_windows"]),
+            if meta["fresh_noise_every_epoch"].as_bool() == Some(true) {
+                "; networks trained at an SNR draw new input noise every epoch (validation and test keep one fixed, seeded realisation)"
+            } else {
+                "; networks trained on one fixed noise realisation"
+            },
+            t["classical_rows"],
+        ));
+    }
+    let mut data: Vec<(String, String)> = Vec::new();
+    for f in Which::FOLDERS {
+        if let Some(m) = read(out.join(f).join("meta.json")) {
+            data.push((
+                f.to_string(),
+                m["data_fnv1a"].as_str().unwrap_or("?").to_string(),
+            ));
+        }
+    }
+    if data.windows(2).any(|w| w[0].1 != w[1].1) {
+        intro.push(format!(
+            "Note: these parts were computed on different data: {}.",
+            data.iter()
+                .map(|(f, h)| format!("{f} {h}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    write_index(
+        out,
+        "railforce: wheel–rail force identification experiments",
+        &intro,
+        &Which::FOLDERS,
+    )?;
+    Ok(out.join("index.html"))
 }
 
 /// Runs the experiments `which` (each expanded by [`Which::parts`], in order, without
@@ -422,7 +478,7 @@ pub fn run(
             split.describe()
         ));
     }
-    let manifest_hash = crate::dataset::file_hash(&data_dir.join("manifest.json"))?;
+    let data_hash = crate::dataset::data_identity(&data_dir)?;
     let conditions: Vec<String> = plan.conditions.iter().map(|c| c.name.clone()).collect();
     if parts
         .iter()
@@ -444,27 +500,11 @@ pub fn run(
         conditions,
         pooled: None,
     };
-    let mut sections: Vec<(String, Section)> = Vec::new();
     let mut timings = serde_json::Map::new();
-    for part in parts.clone() {
-        let ts = Instant::now();
-        let sec = match part {
-            Which::Comparison => comparison::run(&mut ctx)?,
-            Which::Generalization => generalization::run(&mut ctx)?,
-            Which::Robustness => robustness::run(&mut ctx)?,
-            Which::Protocols => protocols::run(&mut ctx)?,
-            _ => sensors::run(&mut ctx)?,
-        };
-        let folder = part.folder();
-        sec.write_files(&opts.out.join(folder))?;
-        sections.push((folder.into(), sec));
-        timings.insert(format!("{folder}_s"), json!(ts.elapsed().as_secs_f64()));
-    }
-    let wall = t0.elapsed().as_secs_f64();
-    let meta = json!({
+    let common = json!({
         "plan": opts.plan.display().to_string(),
         "plan_name": plan.name,
-        "data_manifest_fnv1a": manifest_hash,
+        "data_fnv1a": data_hash,
         "runs": runs,
         "snr_db": opts.snr_db,
         "noise": opts.noise(opts.snr_db),
@@ -478,51 +518,47 @@ pub fn run(
         "window": opts.window,
         "fresh_noise_every_epoch": opts.fresh_noise,
         "railforce_version": env!("CARGO_PKG_VERSION"),
-        "wall_seconds": wall,
-        "timings": timings,
     });
+    for part in parts.clone() {
+        let ts = Instant::now();
+        let mut sec = match part {
+            Which::Comparison => comparison::run(&mut ctx)?,
+            Which::Generalization => generalization::run(&mut ctx)?,
+            Which::Robustness => robustness::run(&mut ctx)?,
+            Which::Protocols => protocols::run(&mut ctx)?,
+            _ => sensors::run(&mut ctx)?,
+        };
+        let secs = ts.elapsed().as_secs_f64();
+        let folder = part.folder();
+        // Each part says where it comes from: parts run at different times into one folder
+        // keep their own provenance.
+        sec.text.insert(
+            0,
+            format!(
+                "railforce {}, plan {} ({} runs, data {}), training seed {}; this part took {:.0} s.",
+                env!("CARGO_PKG_VERSION"),
+                plan.name,
+                runs,
+                data_hash,
+                opts.train.seed,
+                secs
+            ),
+        );
+        sec.write_files(&opts.out.join(folder))?;
+        let mut pm = common.clone();
+        pm["wall_seconds"] = json!(secs);
+        let pj = serde_json::to_string_pretty(&pm).expect("meta serialises");
+        crate::io::write_atomic(&opts.out.join(folder).join("meta.json"), |w| {
+            w.write_all(pj.as_bytes())
+        })?;
+        timings.insert(format!("{folder}_s"), json!(secs));
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let mut meta = common.clone();
+    meta["wall_seconds"] = json!(wall);
+    meta["timings"] = json!(timings);
     let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");
     crate::io::write_atomic(&opts.out.join("meta.json"), |w| w.write_all(mj.as_bytes()))?;
-    let intro = vec![
-        format!(
-            "railforce {} — plan {} ({} runs, data manifest {}), training seed {}, wall time {:.0} s.",
-            env!("CARGO_PKG_VERSION"),
-            plan.name,
-            runs,
-            manifest_hash,
-            opts.train.seed,
-            wall
-        ),
-        ctx.protocol(&split, Some(opts.snr_db)),
-        "Paper numbers come from another simulator and an unstated (apparently shuffled) split: a bar, not a target to match digit for digit.".into(),
-        format!(
-            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch ({} on one condition), validation on at most {} windows{}; classical models on at most {} windows.",
-            opts.train.lr,
-            opts.train.batch,
-            opts.train.epochs,
-            opts.train.patience,
-            opts.train
-                .windows_per_epoch
-                .map(|w| w.to_string())
-                .unwrap_or("all".into()),
-            opts.condition_windows_per_epoch,
-            opts.train
-                .val_windows
-                .map(|w| w.to_string())
-                .unwrap_or("all".into()),
-            if opts.fresh_noise {
-                "; networks trained at an SNR draw new input noise every epoch (validation and test keep one fixed, seeded realisation)"
-            } else {
-                "; networks trained on one fixed noise realisation"
-            },
-            opts.train.classical_rows
-        ),
-    ];
-    write_index(
-        &opts.out,
-        "railforce: wheel–rail force identification experiments",
-        &intro,
-        &sections,
-    )?;
+    write_report(&opts.out)?;
     Ok(opts.out.join("index.html"))
 }

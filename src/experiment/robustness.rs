@@ -117,10 +117,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 }
             }
             for k in 0..2 {
-                series[k].push(Series {
-                    label: kind.name().into(),
-                    points: std::mem::take(&mut pts[k]),
-                });
+                series[k].push(Series::line(kind.name(), std::mem::take(&mut pts[k])));
             }
         }
         let stem = if proto == NoiseProtocol::Matched {
@@ -129,16 +126,34 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             "train_clean"
         };
         for (k, name) in [(0, "FL"), (1, "FQ")] {
+            let mut lines = std::mem::take(&mut series[k]);
+            if proto == NoiseProtocol::Matched && opts.snrs.contains(&1.0) {
+                // The paper's Fig. 8 values at 1 dB (one per model, its target unstated).
+                for &kind in &opts.robustness_models {
+                    if let Some((_, v)) = paper::ROBUSTNESS_1DB
+                        .iter()
+                        .find(|(n, _)| *n == kind.name())
+                    {
+                        lines.push(Series::points(
+                            format!("paper {} (1 dB)", kind.name()),
+                            vec![(1.0, *v)],
+                        ));
+                    }
+                }
+            }
             charts.push((
                 format!("{name}: test R² against SNR ({label}); 1000 dB drawn at 100"),
-                Chart {
-                    title: format!("{name} R² vs SNR: {label}"),
-                    x_label: "SNR (dB)".into(),
-                    y_label: format!("test R², {name}"),
-                    log_x: false,
-                    y_range: None,
-                    series: std::mem::take(&mut series[k]),
-                },
+                Chart::new(
+                    format!("{name} test R² against SNR: {label}"),
+                    if opts.snrs.iter().any(|&s| s > 100.0) {
+                        "SNR (dB, linear axis; the clean 1000 dB case drawn at 100)"
+                    } else {
+                        "SNR (dB, linear axis)"
+                    },
+                    format!("test R², {name}"),
+                    lines,
+                )
+                .into(),
                 format!("r2_vs_snr_{}_{stem}.svg", name.to_lowercase()),
             ));
         }

@@ -731,6 +731,15 @@ pub enum Part {
 }
 
 impl NoiseProtocol {
+    /// In words, for people (`train and test on noisy inputs`).
+    pub fn describe(self) -> &'static str {
+        match self {
+            NoiseProtocol::Clean => "clean inputs throughout",
+            NoiseProtocol::Matched => "trained and tested on noisy inputs (matched)",
+            NoiseProtocol::TrainCleanTestNoisy => "trained on clean inputs, tested on noisy ones",
+        }
+    }
+
     /// The column a part reads for the input `channel`.
     pub fn column(self, channel: &str, part: Part) -> String {
         let noisy = match self {

@@ -5,7 +5,7 @@ use super::metrics::{Metrics, metrics};
 use super::model::Model;
 use super::windows::prepare;
 use crate::error::Result;
-use crate::features::{DataSet, Split};
+use crate::features::{DataSet, Split, ZScore};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
@@ -79,6 +79,66 @@ pub fn evaluate(model: &mut Model, ds: &DataSet, part: EvalPart) -> Result<Evalu
 }
 
 impl Evaluation {
+    /// Metrics of every condition on its own (conditions in the order they first appear),
+    /// from the prediction rows; `stats` are the model's target z-scores. Pooled back
+    /// (`Σ n·mse / Σ n`) they give the pooled MSE.
+    pub fn per_condition(&self, stats: &ZScore) -> Vec<(String, Vec<Metrics>)> {
+        let mut order: Vec<&str> = Vec::new();
+        for r in &self.rows {
+            if order.last() != Some(&r.0.as_str()) && !order.contains(&r.0.as_str()) {
+                order.push(&r.0);
+            }
+        }
+        let o = stats.names.len();
+        order
+            .into_iter()
+            .map(|c| {
+                let (mut y, mut p) = (Vec::new(), Vec::new());
+                for r in self.rows.iter().filter(|r| r.0 == c) {
+                    for k in 0..o {
+                        let z = |v: f64| ((v - stats.mean[k]) / stats.std[k]) as f32;
+                        y.push(z(r.3[k].0));
+                        p.push(z(r.3[k].1));
+                    }
+                }
+                (c.to_string(), metrics(&y, &p, stats))
+            })
+            .collect()
+    }
+
+    /// The condition with the lowest R² of target `k`, and that R².
+    pub fn worst_condition(
+        per_condition: &[(String, Vec<Metrics>)],
+        k: usize,
+    ) -> Option<(&str, f64)> {
+        per_condition
+            .iter()
+            .filter_map(|(c, m)| m.get(k).map(|m| (c.as_str(), m.r2)))
+            .filter(|(_, r2)| r2.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// Writes per-condition metrics as tidy CSV: one row per condition and target, then the
+    /// pooled rows (`condition` = `all`).
+    pub fn write_condition_csv(
+        &self,
+        path: &Path,
+        per_condition: &[(String, Vec<Metrics>)],
+    ) -> Result<()> {
+        let mut s = String::from("condition,target,n,mse,r2,var_y,rmse_kn,mae_kn\n");
+        let all = [("all".to_string(), self.metrics.clone())];
+        for (c, ms) in per_condition.iter().chain(all.iter()) {
+            for m in ms {
+                let _ = writeln!(
+                    s,
+                    "{c},{},{},{:.6},{:.6},{:.6},{:.4},{:.4}",
+                    m.target, m.n, m.mse, m.r2, m.var_y, m.rmse_kn, m.mae_kn
+                );
+            }
+        }
+        crate::io::write_atomic(path, |w| w.write_all(s.as_bytes()))
+    }
+
     /// Writes the predictions as CSV (`condition,seed,time_s,<target>_true_N,<target>_pred_N…`).
     pub fn write_csv(&self, path: &Path, targets: &[String]) -> Result<()> {
         let mut s = String::from("condition,seed,time_s");

@@ -162,10 +162,9 @@ pub fn train(
         }
         _ => None,
     };
-    let manifest = ds.dir.join("manifest.json");
     let identity = json!({
         "folder": ds.dir.display().to_string(),
-        "manifest_fnv1a": crate::dataset::file_hash(&manifest).ok(),
+        "data_fnv1a": crate::dataset::data_identity(&ds.dir).ok(),
         "runs": ds.runs.len(),
         "seeds": ds.runs.iter().map(|r| r.seed).collect::<std::collections::BTreeSet<_>>(),
         "conditions": ds.runs.iter().map(|r| r.condition.clone()).collect::<std::collections::BTreeSet<_>>(),
@@ -252,12 +251,16 @@ pub fn train(
             Engine::Classical(Box::new(model))
         }
     };
+    let is_net = kind.architecture().is_some();
     if let Some(obj) = meta.training.as_object_mut() {
         obj.insert("wall_seconds".into(), json!(t0.elapsed().as_secs_f64()));
-        obj.insert(
-            "options".into(),
-            serde_json::to_value(opts).expect("options serialise"),
-        );
+        // The settings that applied: a tree has no epochs, batch or learning rate.
+        let settings = if is_net {
+            serde_json::to_value(opts).expect("options serialise")
+        } else {
+            json!({ "classical_rows": opts.classical_rows, "seed": opts.seed })
+        };
+        obj.insert("options".into(), settings);
     }
     let model = Model { meta, engine };
     model.save(out)?;
@@ -529,6 +532,7 @@ fn train_network(
         "epochs_run": log.len(),
         "best_epoch": t.best_epoch,
         "best_val_loss": t.best_val,
+        "best_val_r2": log.iter().find(|e| e.epoch == t.best_epoch).map(|e| e.val_r2.clone()),
         "stopped_early": stopped_early || t.bad >= opts.patience,
         "training_windows": job.train.len(),
         "validation_windows": job.val.len(),
