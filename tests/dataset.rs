@@ -92,9 +92,11 @@ fn generate_resume_shard_merge_and_formats() {
     assert_ne!(col("frame_l_acc_y"), col("frame_l_acc_y_noisy"));
 
     // A rerun skips everything and changes no byte.
+    let identity = dataset::data_identity(&a).unwrap();
     let (_, ev) = run_events(&plan, &opts(&a, Format::Npz, None));
     assert_eq!(started(&ev), 0);
     assert_eq!(std::fs::read(&file).unwrap(), bytes);
+    assert_eq!(dataset::data_identity(&a).unwrap(), identity);
 
     // Interruption: one file lost and the manifest written before it finished.
     let manifest_path = a.join("manifest.json");
@@ -114,6 +116,9 @@ fn generate_resume_shard_merge_and_formats() {
         "same seed, same bytes"
     );
     assert_eq!(m2["runs"].as_array().unwrap().len(), 3);
+    // The redone run has a new wall time in the manifest but the same bytes: the data
+    // identity (what reports and models quote) is unchanged.
+    assert_eq!(dataset::data_identity(&a).unwrap(), identity);
 
     // Two shards and a merge give the same files and runs.
     let b = dir.join("b");

@@ -277,9 +277,38 @@ fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
         "the model records its SNR"
     );
     let work = dir.join("closed_loop");
-    let checks =
-        closed_loop::validate(&mut model, &plan, 1001, &work, 1, &Limits::default()).unwrap();
+    let limits = Limits::default();
+    let checks = closed_loop::validate(&mut model, &plan, 1001, &work, 1, &limits, 0.2).unwrap();
     assert_eq!(checks.len(), 1);
+    // The report: labelled JSON, tidy traces, a page whose every link resolves.
+    let report = dir.join("report");
+    let settings = railforce::identify::check_report::CheckSettings {
+        model: "tree",
+        plan: "closed",
+        seed: 1001,
+        margin: 0.2,
+        limits: &limits,
+        noise: noise.describe(),
+    };
+    let index = railforce::identify::check_report::write(&report, &checks, &settings).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("closed_loop.json")).unwrap())
+            .unwrap();
+    let first = &json["runs"][0]["safety"][0];
+    assert_eq!(first["index"], "Y/Q");
+    assert_eq!(first["place"], "w1l");
+    assert!(first["true_p99_85"].is_number() && first["verdicts_agree"].is_boolean());
+    let traces = std::fs::read_to_string(report.join("traces.csv")).unwrap();
+    assert!(traces.starts_with(
+        "condition,seed,time_s,w1l_force_y_true_n,w1l_force_y_identified_n,w1l_force_z_true_n"
+    ));
+    assert_eq!(traces.lines().count(), 1 + checks[0].truth.time.len());
+    let html = std::fs::read_to_string(&index).unwrap();
+    for part in html.split("src=\"").skip(1) {
+        let target = part.split('"').next().unwrap();
+        assert!(report.join(target).is_file(), "{target}");
+    }
+    assert!(html.contains("trace_000_w1l_force_z.svg") && html.contains("p99_85_ratio.svg"));
     assert!(checks[0].targets.iter().all(|t| t.rmse_kn.is_finite()));
     let fresh = DataSet::load(&work).unwrap();
     assert_eq!(

@@ -230,7 +230,11 @@ pub fn validate(
     seed: Option<u64>,
     jobs: usize,
     limits: &Limits,
+    margin: f64,
 ) -> Result<()> {
+    if !(0.0..1.0).contains(&margin) {
+        bail!("--margin {margin}: expected a fraction between 0 and 1 (0.2 = 20 %)");
+    }
     let mut model = Model::load(model_dir)?;
     let plan = railforce::plan::Plan::load(&super::builtin::resolve(plan)?)?;
     let seed = seed.unwrap_or_else(|| railforce::identify::closed_loop::fresh_seed(&model));
@@ -252,40 +256,87 @@ pub fn validate(
             ))
             .unwrap_or_else(|| "clean".into())
     );
-    let runs =
-        railforce::identify::closed_loop::validate(&mut model, &plan, seed, &work, jobs, limits)?;
+    let runs = railforce::identify::closed_loop::validate(
+        &mut model, &plan, seed, &work, jobs, limits, margin,
+    )?;
     println!(
-        "{:<22} {:<12} {:>8} {:>9} {:>12}",
+        "{:<22} {:<14} {:>7} {:>9} {:>12}",
         "condition", "target", "R²", "RMSE kN", "peak err kN"
     );
-    let mut agree = true;
     for r in &runs {
         for t in &r.targets {
             println!(
-                "{:<22} {:<12} {:>8.3} {:>9.2} {:>12.2}",
+                "{:<22} {:<14} {:>7.3} {:>9.2} {:>12.2}",
                 r.condition, t.target, t.r2, t.rmse_kn, t.peak_error_kn
             );
         }
-        for (name, tmax, imax, ok) in &r.safety {
-            agree &= ok;
+    }
+    println!(
+        "\n{:<22} {:<16} {:>8} {:>10} {:>11} {:>10} {:>11}  verdicts",
+        "condition", "index", "limit", "true peak", "id ÷ true", "true 99.85", "id ÷ true"
+    );
+    let ratio = |r: Option<f64>| r.map_or("—".to_string(), |r| format!("{r:.2}"));
+    let (mut differ, mut under, mut reached) = (0, Vec::new(), 0);
+    for r in &runs {
+        for c in &r.safety {
+            let exceeds = |b: bool| if b { "over" } else { "within" };
             println!(
-                "{:<22}   {name}: true max {tmax:.3}, identified max {imax:.3}, verdicts {}",
+                "{:<22} {:<16} {:>8.3} {:>10.3} {:>11} {:>10.3} {:>11}  true {}, identified {}{}",
                 r.condition,
-                if *ok { "agree" } else { "DISAGREE" }
+                format!("{} {}", c.index, c.place),
+                c.limit,
+                c.true_peak,
+                ratio(c.peak_ratio),
+                c.true_p99_85,
+                ratio(c.p99_85_ratio),
+                exceeds(c.true_exceeds),
+                exceeds(c.identified_exceeds),
+                if c.verdicts_agree { "" } else { "  DISAGREE" }
             );
+            differ += usize::from(!c.verdicts_agree);
+            reached += usize::from(c.true_exceeds || c.identified_exceeds);
+            if c.underestimated {
+                under.push(format!(
+                    "warning: {} {} {}: identified peak {} × and 99.85 % percentile {} × the true (more than {:.0} % low)",
+                    r.condition,
+                    c.index,
+                    c.place,
+                    ratio(c.peak_ratio),
+                    ratio(c.p99_85_ratio),
+                    100.0 * margin
+                ));
+            }
         }
     }
-    let json = serde_json::to_string_pretty(&runs)?;
-    let p = model_dir.join(format!("closed_loop_seed{seed}.json"));
-    railforce::io::write_atomic(&p, |w| w.write_all(json.as_bytes()))?;
+    for w in &under {
+        eprintln!("{w}");
+    }
+    let checks: usize = runs.iter().map(|r| r.safety.len()).sum();
+    let verdicts = if reached == 0 {
+        "no limit was reached by the truth or the identification, so the verdicts test nothing here"
+            .to_string()
+    } else if differ == 0 {
+        format!("safety verdicts agree on all {checks} (a limit was reached in {reached})")
+    } else {
+        format!("safety verdicts DIFFER on {differ} of {checks}")
+    };
+    let dir = model_dir.join(format!("closed_loop_seed{seed}_report"));
+    let settings = railforce::identify::check_report::CheckSettings {
+        model: &format!("{} ({})", model.meta.kind.name(), model_dir.display()),
+        plan: &plan.name,
+        seed,
+        margin,
+        limits,
+        noise: noise
+            .map(|n| n.describe())
+            .unwrap_or_else(|| "clean".into()),
+    };
+    let index = railforce::identify::check_report::write(&dir, &runs, &settings)?;
     println!(
-        "safety verdicts {}; report {}",
-        if agree {
-            "all agree"
-        } else {
-            "differ somewhere"
-        },
-        p.display()
+        "{verdicts}; {} of {checks} statistics under-identified by more than {:.0} %.\nreport: {} (closed_loop.json, traces.csv beside it)",
+        under.len(),
+        100.0 * margin,
+        index.display()
     );
     Ok(())
 }

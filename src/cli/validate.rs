@@ -15,8 +15,11 @@ pub struct ValidateArgs {
 #[derive(Debug, Subcommand)]
 enum What {
     /// Closed loop: simulate every condition of a plan with a seed never used in training,
-    /// identify the forces with the model and compare with the simulator's truth (R², RMSE,
-    /// peak error, safety verdicts). Writes MODEL/closed_loop_seedN.json.
+    /// identify the forces with the model and compare with the simulator's truth: R², RMSE
+    /// and peak error per target; per safety index and wheel the identified-to-true ratio of
+    /// the peak and of the 99.85 % percentile, with a warning where the identification reads
+    /// more than --margin low, and whether the verdicts agree. Writes
+    /// MODEL/closed_loop_seedN_report/ (index.html with plots, closed_loop.json, traces.csv).
     Identify {
         /// Model directory.
         #[arg(long)]
@@ -30,6 +33,9 @@ enum What {
         /// Simulations in parallel.
         #[arg(long, default_value_t = 2)]
         jobs: usize,
+        /// Warn where an identified statistic is more than this fraction below the true one.
+        #[arg(long, default_value_t = railforce::identify::closed_loop::UNDER_MARGIN)]
+        margin: f64,
         #[command(flatten)]
         limits: super::identify::LimitArgs,
     },
@@ -74,8 +80,9 @@ pub fn run(args: ValidateArgs) -> Result<()> {
             plan,
             seed,
             jobs,
+            margin,
             limits,
-        } => super::identify::validate(&model, &plan, seed, jobs, &limits.limits()?),
+        } => super::identify::validate(&model, &plan, seed, jobs, &limits.limits()?, margin),
         What::Contact { reference_dir } => contact(&match reference_dir {
             Some(d) => cv::Reference::Dir(d),
             None => cv::Reference::Builtin,

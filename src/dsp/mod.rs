@@ -1,5 +1,7 @@
 //! Signal processing shared by several stages (spectral estimates, filters).
 
+pub mod stats;
 pub mod welch;
 
+pub use stats::percentile;
 pub use welch::{WelchPsd, welch_psd};

@@ -26,6 +26,38 @@ pub struct TargetCheck {
     pub peak_error_kn: f64,
 }
 
+/// One safety index of one wheel (or wheelset) of a run: the identified value against the
+/// true one, by its peak and by its 99.85 % percentile (the statistic acceptance uses).
+#[derive(Debug, Clone, Serialize)]
+pub struct IndexCheck {
+    /// Index: `Y/Q`, `ΔQ/Q̄` or `H (kN)`.
+    pub index: String,
+    /// Wheel (`w1l`) or wheelset (`wheelset 1`).
+    pub place: String,
+    /// Limit of the index.
+    pub limit: f64,
+    /// Largest true value.
+    pub true_peak: f64,
+    /// Largest identified value.
+    pub identified_peak: f64,
+    /// `identified_peak / true_peak` (`None` where the true peak is not positive).
+    pub peak_ratio: Option<f64>,
+    /// 99.85 % percentile of the true series.
+    pub true_p99_85: f64,
+    /// 99.85 % percentile of the identified series.
+    pub identified_p99_85: f64,
+    /// `identified_p99_85 / true_p99_85` (`None` where the true value is not positive).
+    pub p99_85_ratio: Option<f64>,
+    /// The true series exceeds the limit somewhere.
+    pub true_exceeds: bool,
+    /// The identified series exceeds the limit somewhere.
+    pub identified_exceeds: bool,
+    /// Both say the same (exceeds or not).
+    pub verdicts_agree: bool,
+    /// A ratio is below `1 − margin`: the identification under-reads this index.
+    pub underestimated: bool,
+}
+
 /// Result for one run.
 #[derive(Debug, Clone, Serialize)]
 pub struct RunCheck {
@@ -35,8 +67,53 @@ pub struct RunCheck {
     pub seed: u64,
     /// Per target.
     pub targets: Vec<TargetCheck>,
-    /// Per safety index: (name, true max, identified max, verdicts agree).
-    pub safety: Vec<(String, f64, f64, bool)>,
+    /// Per safety index and wheel.
+    pub safety: Vec<IndexCheck>,
+    /// The simulator's forces at the label times.
+    #[serde(skip)]
+    pub truth: Identified,
+    /// The identified forces.
+    #[serde(skip)]
+    pub identified: Identified,
+}
+
+/// Default margin of [`IndexCheck::underestimated`]: an identified statistic more than 20 %
+/// below the true one.
+pub const UNDER_MARGIN: f64 = 0.2;
+
+/// Compares the safety indices of the truth and the identification.
+pub fn compare_indices(
+    truth: &Identified,
+    identified: &Identified,
+    limits: &Limits,
+    margin: f64,
+) -> Vec<IndexCheck> {
+    let p = |r: &super::safety::IndexReport| crate::dsp::percentile(&r.series, 99.85);
+    let ratio = |a: f64, b: f64| (b > 1e-9 && a.is_finite()).then(|| a / b);
+    indices(truth, limits)
+        .iter()
+        .zip(&indices(identified, limits))
+        .map(|(t, i)| {
+            let (tp, ip) = (p(t), p(i));
+            let (peak_ratio, p99_85_ratio) = (ratio(i.max, t.max), ratio(ip, tp));
+            let under = |r: Option<f64>| r.is_some_and(|r| r < 1.0 - margin);
+            IndexCheck {
+                index: t.index.clone(),
+                place: t.place.clone(),
+                limit: t.limit,
+                true_peak: t.max,
+                identified_peak: i.max,
+                peak_ratio,
+                true_p99_85: tp,
+                identified_p99_85: ip,
+                p99_85_ratio,
+                true_exceeds: !t.exceedances.is_empty(),
+                identified_exceeds: !i.exceedances.is_empty(),
+                verdicts_agree: t.exceedances.is_empty() == i.exceedances.is_empty(),
+                underestimated: under(peak_ratio) || under(p99_85_ratio),
+            }
+        })
+        .collect()
 }
 
 /// The seed a closed-loop check uses by default: one above every training seed.
@@ -56,6 +133,7 @@ pub fn validate(
     work: &Path,
     jobs: usize,
     limits: &Limits,
+    margin: f64,
 ) -> Result<Vec<RunCheck>> {
     let used: Vec<u64> = model.meta.data_identity["seeds"]
         .as_array()
@@ -136,25 +214,56 @@ pub fn validate(
                 }
             })
             .collect();
-        let (ti, ii) = (indices(&truth, limits), indices(&id, limits));
-        let safety = ti
-            .iter()
-            .zip(&ii)
-            .map(|(a, b)| {
-                (
-                    a.name.clone(),
-                    a.max,
-                    b.max,
-                    a.exceedances.is_empty() == b.exceedances.is_empty(),
-                )
-            })
-            .collect();
+        let safety = compare_indices(&truth, &id, limits, margin);
         out.push(RunCheck {
             condition: run.condition.clone(),
             seed: run.seed,
             targets,
             safety,
+            truth,
+            identified: id,
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A planted 40 % under-identification of the lateral force is flagged on Y/Q, and the
+    /// vertical force identified exactly is not.
+    #[test]
+    fn a_planted_under_identification_warns() {
+        let n = 400;
+        let time: Vec<f64> = (0..n).map(|i| i as f64 * 0.005).collect();
+        let truth = Identified {
+            targets: vec!["w1l_force_y".into(), "w1l_force_z".into()],
+            time: time.clone(),
+            values: (0..n)
+                .map(|i| {
+                    let y = 40e3 + 30e3 * (i as f64 * 0.05).sin();
+                    vec![y, 110e3 - 20e3 * (i as f64 * 0.03).cos()]
+                })
+                .collect(),
+        };
+        let mut id = truth.clone();
+        for v in &mut id.values {
+            v[0] *= 0.6;
+        }
+        let checks = compare_indices(&truth, &id, &Limits::default(), UNDER_MARGIN);
+        let yq = checks.iter().find(|c| c.index == "Y/Q").unwrap();
+        assert!(yq.underestimated);
+        assert!((yq.peak_ratio.unwrap() - 0.6).abs() < 1e-9);
+        assert!((yq.p99_85_ratio.unwrap() - 0.6).abs() < 1e-9);
+        let dq = checks.iter().find(|c| c.index != "Y/Q").unwrap();
+        assert!(!dq.underestimated && dq.verdicts_agree);
+        assert!((dq.peak_ratio.unwrap() - 1.0).abs() < 1e-12);
+        // 10 % low stays within a 20 % margin.
+        for v in &mut id.values {
+            v[0] *= 0.9 / 0.6;
+        }
+        let checks = compare_indices(&truth, &id, &Limits::default(), UNDER_MARGIN);
+        assert!(checks.iter().all(|c| !c.underestimated));
+    }
 }

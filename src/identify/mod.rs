@@ -4,6 +4,7 @@
 //! Y/Q, wheel unloading and wheelset lateral force with an exceedance report. [`Streamer`]
 //! does the same one sample at a time.
 
+pub mod check_report;
 pub mod closed_loop;
 pub mod safety;
 

@@ -39,6 +39,10 @@ impl Limits {
 pub struct IndexReport {
     /// Name, e.g. `Y/Q w1l`.
     pub name: String,
+    /// The index alone: `Y/Q`, `ΔQ/Q̄` or `H (kN)`.
+    pub index: String,
+    /// Where: the wheel (`w1l`) or the wheelset (`wheelset 1`).
+    pub place: String,
     /// Limit.
     pub limit: f64,
     /// Largest value and when.
@@ -83,11 +87,11 @@ pub fn indices(id: &Identified, limits: &Limits) -> Vec<IndexReport> {
                 .zip(col(q))
                 .map(|(y, q)| y.abs() / q.max(1.0))
                 .collect();
-            out.push(report(format!("Y/Q {w}"), limits.y_over_q, s, &id.time));
+            out.push(report("Y/Q", w, limits.y_over_q, s, &id.time));
         }
         if let Some(q) = find(w, 'z') {
             let s = col(q).iter().map(|q| (q_bar - q) / q_bar).collect();
-            out.push(report(format!("ΔQ/Q̄ {w}"), limits.unloading, s, &id.time));
+            out.push(report("ΔQ/Q̄", w, limits.unloading, s, &id.time));
         }
     }
     for axle in 1..=4 {
@@ -99,7 +103,8 @@ pub fn indices(id: &Identified, limits: &Limits) -> Vec<IndexReport> {
                 .map(|(a, b)| ((a + b) / 1000.0).abs())
                 .collect();
             out.push(report(
-                format!("H wheelset {axle} (kN)"),
+                "H (kN)",
+                &format!("wheelset {axle}"),
                 limits.lateral_kn(),
                 s,
                 &id.time,
@@ -109,7 +114,11 @@ pub fn indices(id: &Identified, limits: &Limits) -> Vec<IndexReport> {
     out
 }
 
-fn report(name: String, limit: f64, series: Vec<f64>, time: &[f64]) -> IndexReport {
+fn report(index: &str, place: &str, limit: f64, series: Vec<f64>, time: &[f64]) -> IndexReport {
+    let name = match index.strip_suffix(" (kN)") {
+        Some(bare) => format!("{bare} {place} (kN)"),
+        None => format!("{index} {place}"),
+    };
     let (imax, &max) = series
         .iter()
         .enumerate()
@@ -133,6 +142,8 @@ fn report(name: String, limit: f64, series: Vec<f64>, time: &[f64]) -> IndexRepo
     }
     IndexReport {
         name,
+        index: index.to_string(),
+        place: place.to_string(),
         limit,
         max,
         max_time_s: time.get(imax).copied().unwrap_or(f64::NAN),

@@ -156,3 +156,52 @@ impl Evaluation {
         crate::io::write_atomic(path, |w| w.write_all(s.as_bytes()))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn per_condition_metrics_pool_back_to_the_pooled_figure() {
+        let stats = ZScore {
+            names: vec!["w1l_force_y".into(), "w1l_force_z".into()],
+            mean: vec![5e3, 110e3],
+            std: vec![8e3, 15e3],
+        };
+        let (mut y, mut p, mut rows) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..300 {
+            let c = ["tangent", "curve", "grade"][i % 3];
+            let x = i as f64 * 0.37;
+            let pairs: Vec<(f64, f64)> = (0..2)
+                .map(|k| {
+                    let t = stats.mean[k] + stats.std[k] * x.sin() * (1.0 + (i % 3) as f64);
+                    (t, t + stats.std[k] * 0.3 * (x * 1.7).cos())
+                })
+                .collect();
+            for (k, (t, q)) in pairs.iter().enumerate() {
+                y.push(((t - stats.mean[k]) / stats.std[k]) as f32);
+                p.push(((q - stats.mean[k]) / stats.std[k]) as f32);
+            }
+            rows.push((c.to_string(), 1, i as f64 * 0.005, pairs));
+        }
+        let ev = Evaluation {
+            metrics: metrics(&y, &p, &stats),
+            windows_per_s: 0.0,
+            rows,
+        };
+        let per = ev.per_condition(&stats);
+        assert_eq!(
+            per.iter().map(|c| c.0.as_str()).collect::<Vec<_>>(),
+            ["tangent", "curve", "grade"]
+        );
+        for k in 0..2 {
+            let n: usize = per.iter().map(|c| c.1[k].n).sum();
+            let sse: f64 = per.iter().map(|c| c.1[k].n as f64 * c.1[k].mse).sum();
+            assert_eq!(n, ev.metrics[k].n);
+            assert!((sse / n as f64 - ev.metrics[k].mse).abs() < 1e-6 * ev.metrics[k].mse);
+        }
+        // The tangent has the smallest spread, so the lowest R² for the same error.
+        let worst = Evaluation::worst_condition(&per, 0).unwrap();
+        assert_eq!(worst.0, "tangent");
+    }
+}
