@@ -224,6 +224,41 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 .into(),
                 format!("trace_{}.svg", name.to_lowercase()),
             ));
+            // A 4 s close-up around the largest true force, where a whole run's trace is too
+            // dense to read.
+            if let Some(peak) = run
+                .iter()
+                .max_by(|a, b| a.3[0].0.abs().total_cmp(&b.3[0].0.abs()))
+                .map(|r| r.2)
+                && span.1 - span.0 > 8.0
+            {
+                let from = (peak - 2.0).clamp(span.0, span.1 - 4.0);
+                let near: Vec<&&PredictionRow> = run
+                    .iter()
+                    .filter(|r| r.2 >= from && r.2 <= from + 4.0)
+                    .collect();
+                sec.figures.push((
+                    format!(
+                        "{name}: close-up of {:.1}–{:.1} s around the largest true force of the same run",
+                        from,
+                        from + 4.0
+                    ),
+                    Chart::new(
+                        format!("{name}, {}: close-up, seed {seed}", kind.name()),
+                        "time (s)",
+                        "force (kN)",
+                        vec![
+                            Series::line("true", near.iter().map(|r| (r.2, r.3[0].0 / 1000.0)).collect()),
+                            Series::line(
+                                format!("{} (identified)", kind.name()),
+                                near.iter().map(|r| (r.2, r.3[0].1 / 1000.0)).collect(),
+                            ),
+                        ],
+                    )
+                    .into(),
+                    format!("trace_{}_zoom.svg", name.to_lowercase()),
+                ));
+            }
         }
     }
     Ok(sec)

@@ -390,7 +390,8 @@ pub fn write_report(out: &Path) -> Result<PathBuf> {
     if t.is_object() {
         intro.push(format!(
             "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch ({} on one condition), validation on at most {} windows{}; classical models on at most {} windows.",
-            t["lr"],
+            // lr is an f32: print its decimal, not its binary expansion.
+            t["lr"].as_f64().map_or("?".into(), |v| format!("{}", v as f32)),
             t["batch"],
             t["epochs"],
             t["patience"],
