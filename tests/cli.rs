@@ -210,7 +210,7 @@ fn select_onboard_then_train_on_noisy_inputs() {
     assert!(err.contains("drawing the noisy copies"), "{err}");
     assert!(out.contains("split by seed"), "{out}");
     let model = tmp("onboard_model");
-    let (ok, _, err) = railforce(&[
+    let (ok, out_train, err) = railforce(&[
         "train",
         "--data",
         data.to_str().unwrap(),
@@ -224,8 +224,44 @@ fn select_onboard_then_train_on_noisy_inputs() {
         model.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
+    // train speaks to people: the target by name, the settings that apply, a summary line.
+    assert!(
+        out_train.contains("→ FQ") && out_train.contains("validation R² FQ "),
+        "{out_train}"
+    );
+    assert!(
+        out_train.contains("fitted on at most") && !out_train.contains("Adam"),
+        "{out_train}"
+    );
+    assert!(
+        !out_train.contains("Blocks {") && !out_train.contains("Matched"),
+        "{out_train}"
+    );
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(model.join("model.json")).unwrap()).unwrap();
+    assert!(
+        meta["training"]["options"]["epochs"].is_null(),
+        "a tree has no epochs"
+    );
+    // evaluate: per condition beside the pooled figure, the worst condition in the summary.
+    let (ok, out, err) = railforce(&[
+        "evaluate",
+        "--model",
+        model.to_str().unwrap(),
+        "--data",
+        data.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("all (pooled)") && out.contains(", worst "),
+        "{out}"
+    );
+    let per = std::fs::read_to_string(model.join("metrics_per_condition.csv")).unwrap();
+    assert!(
+        per.starts_with("condition,target,n,mse,r2,var_y,rmse_kn,mae_kn\n"),
+        "{per}"
+    );
+    assert!(per.lines().any(|l| l.starts_with("all,")), "{per}");
     assert_eq!(meta["data"]["noise"], "Matched");
     assert_eq!(meta["data"]["noise_model"]["snr_db"], 6.0);
     assert_eq!(meta["data"]["noise_model"]["reference"], "std");
@@ -309,6 +345,18 @@ fn demo_runs_from_an_empty_folder() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(dir.join("demo/index.html").exists());
+    // Every link of the report resolves.
+    let html = std::fs::read_to_string(dir.join("demo/index.html")).unwrap();
+    let mut links = 0;
+    for attr in ["href=\"", "src=\""] {
+        for part in html.split(attr).skip(1) {
+            let target = part.split('"').next().unwrap();
+            if !target.starts_with('#') {
+                assert!(dir.join("demo").join(target).is_file(), "{target}");
+                links += 1;
+            }
+        }
+    }
+    assert!(links >= 20, "{links} links");
     let _ = std::fs::remove_dir_all(&dir);
 }
