@@ -1,7 +1,9 @@
 //! Plan files: the list of working conditions a data set is generated from.
 //!
-//! A plan names a vehicle, default duration and seeds, and any number of `[[condition]]`
-//! tables (name, track file, speed, optional overrides). Paths are relative to the plan file.
+//! A plan names a vehicle, default duration and seeds, optional data-set options
+//! (`[dataset]`: a channel subset, float32 storage) and any number of `[[condition]]` tables
+//! (name, track file, speed, and optional overrides: vehicle, duration, seeds, irregularity
+//! class, start position). Paths are relative to the plan file; the README lists every key.
 
 use crate::error::{Error, Result};
 use serde::Deserialize;
@@ -13,14 +15,25 @@ struct PlanFile {
     name: Option<String>,
     vehicle: String,
     duration_s: f64,
-    #[serde(default = "default_seeds")]
-    seeds: Vec<u64>,
+    seeds: Option<SeedsFile>,
+    dataset: Option<DatasetFile>,
     #[serde(default)]
     condition: Vec<ConditionFile>,
 }
 
-fn default_seeds() -> Vec<u64> {
-    vec![1]
+/// Seeds as a list (`[1, 2, 3]`) or an inclusive range (`"1-10"`).
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum SeedsFile {
+    List(Vec<u64>),
+    Range(String),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DatasetFile {
+    channels: Option<Vec<String>>,
+    float32: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -29,8 +42,73 @@ struct ConditionFile {
     name: String,
     track: String,
     speed_kmh: f64,
+    vehicle: Option<String>,
     duration_s: Option<f64>,
-    seeds: Option<Vec<u64>>,
+    seeds: Option<SeedsFile>,
+    class: Option<i64>,
+    start_m: Option<f64>,
+}
+
+/// Largest number of seeds one list or range may give (a typo such as `"1-100000000"` should
+/// fail, not plan a hundred million runs).
+const MAX_SEEDS: u64 = 100_000;
+
+fn seeds(path: &Path, field: &str, s: SeedsFile) -> Result<Vec<u64>> {
+    let v = match s {
+        SeedsFile::List(v) => v,
+        SeedsFile::Range(r) => {
+            let bad = || {
+                Error::config(
+                    path,
+                    field,
+                    format!("\"{r}\": give a list such as [1, 2, 3] or a range such as \"1-10\""),
+                )
+            };
+            let (a, b) = r.split_once('-').ok_or_else(bad)?;
+            let (a, b): (u64, u64) = (
+                a.trim().parse().map_err(|_| bad())?,
+                b.trim().parse().map_err(|_| bad())?,
+            );
+            if b < a || b - a >= MAX_SEEDS {
+                return Err(Error::config(
+                    path,
+                    field,
+                    format!(
+                        "\"{r}\": the range must run upwards and hold at most {MAX_SEEDS} seeds"
+                    ),
+                ));
+            }
+            (a..=b).collect()
+        }
+    };
+    if v.is_empty() {
+        return Err(Error::config(path, field, "give at least one seed"));
+    }
+    if v.len() as u64 > MAX_SEEDS {
+        return Err(Error::config(
+            path,
+            field,
+            format!("more than {MAX_SEEDS} seeds"),
+        ));
+    }
+    let mut sorted = v.clone();
+    sorted.sort_unstable();
+    if sorted.windows(2).any(|w| w[0] == w[1]) {
+        return Err(Error::config(path, field, "a seed is listed twice"));
+    }
+    Ok(v)
+}
+
+/// Data-set options of a plan (`[dataset]`), recorded in the manifest.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct DatasetOptions {
+    /// Channels to keep, by name or kind (`input`, `input_noisy`, `label`, `wheel`, `truth`
+    /// …, see the manifest's `channels`); `time_s`, `s_m` and the labels are always kept.
+    /// Empty: every channel.
+    pub channels: Vec<String>,
+    /// Store the values as 32-bit floats (half the size; time and position stay f64 in
+    /// NPZ and Parquet, CSV prints float32 precision).
+    pub float32: bool,
 }
 
 /// One working condition of a plan.
@@ -46,6 +124,13 @@ pub struct Condition {
     pub duration: f64,
     /// Irregularity seeds: one run per seed.
     pub seeds: Vec<u64>,
+    /// Vehicle file (the plan's unless the condition names its own).
+    pub vehicle: PathBuf,
+    /// FRA class of the irregularities instead of the track file's (1–6).
+    pub class: Option<i64>,
+    /// Distance along the track of the vehicle centre at the start, m (default: just far
+    /// enough for the rear wheelset to be on the track).
+    pub start_m: Option<f64>,
 }
 
 impl Condition {
@@ -66,6 +151,8 @@ pub struct Plan {
     pub vehicle: PathBuf,
     /// Conditions in file order.
     pub conditions: Vec<Condition>,
+    /// Data-set options.
+    pub dataset: DatasetOptions,
 }
 
 impl Plan {
@@ -86,9 +173,27 @@ impl Plan {
             }
         };
         positive("duration_s".into(), raw.duration_s)?;
-        if raw.seeds.is_empty() {
-            return Err(Error::config(path, "seeds", "give at least one seed"));
-        }
+        let plan_seeds = match raw.seeds {
+            Some(s) => seeds(path, "seeds", s)?,
+            None => vec![1],
+        };
+        let dataset = match raw.dataset {
+            None => DatasetOptions::default(),
+            Some(d) => {
+                let channels = d.channels.unwrap_or_default();
+                if let Some(c) = channels.iter().find(|c| c.trim().is_empty()) {
+                    return Err(Error::config(
+                        path,
+                        "dataset.channels",
+                        format!("\"{c}\" is empty: name a channel or a kind"),
+                    ));
+                }
+                DatasetOptions {
+                    channels,
+                    float32: d.float32.unwrap_or(false),
+                }
+            }
+        };
         if raw.condition.is_empty() {
             return Err(Error::config(
                 path,
@@ -130,9 +235,27 @@ impl Plan {
                 ));
             }
             let duration = positive(f("duration_s"), c.duration_s.unwrap_or(raw.duration_s))?;
-            let seeds = c.seeds.unwrap_or_else(|| raw.seeds.clone());
-            if seeds.is_empty() {
-                return Err(Error::config(path, f("seeds"), "give at least one seed"));
+            let seeds = match c.seeds {
+                Some(s) => seeds(path, &f("seeds"), s)?,
+                None => plan_seeds.clone(),
+            };
+            if let Some(k) = c.class
+                && !(1..=6).contains(&k)
+            {
+                return Err(Error::config(
+                    path,
+                    f("class"),
+                    format!("unknown FRA class {k}: use 1 to 6"),
+                ));
+            }
+            if let Some(s) = c.start_m
+                && !(s.is_finite() && s >= 0.0)
+            {
+                return Err(Error::config(
+                    path,
+                    f("start_m"),
+                    format!("must be a distance ≥ 0 along the track, got {s}"),
+                ));
             }
             conditions.push(Condition {
                 name: c.name,
@@ -140,6 +263,9 @@ impl Plan {
                 speed_kmh: speed,
                 duration,
                 seeds,
+                vehicle: dir.join(c.vehicle.as_deref().unwrap_or(&raw.vehicle)),
+                class: c.class,
+                start_m: c.start_m,
             });
         }
         Ok(Plan {
@@ -151,6 +277,7 @@ impl Plan {
             }),
             vehicle: dir.join(raw.vehicle),
             conditions,
+            dataset,
         })
     }
 }

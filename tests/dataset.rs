@@ -262,3 +262,160 @@ fn bad_shard_is_refused() {
     .to_string();
     assert!(e.contains("--shard"), "{e}");
 }
+
+/// Every per-condition key of a plan is read, and a bad one is refused with the file and key.
+#[test]
+fn plan_keys_are_read_and_bad_ones_named() {
+    let dir = temp("plankeys");
+    let r = root();
+    let write = |text: &str| {
+        let p = dir.join("k.plan.toml");
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let head = format!(
+        "vehicle = \"{}\"\nduration_s = 1.0\nseeds = \"2-4\"\n",
+        r.join("vehicles/c80.toml").display()
+    );
+    let cond = format!(
+        "[[condition]]\nname = \"c\"\ntrack = \"{}\"\nspeed_kmh = 60.0\n",
+        r.join("tracks/curve_r400.toml").display()
+    );
+    let good = format!(
+        "{head}[dataset]\nchannels = [\"input\", \"carbody_acc_y\"]\nfloat32 = true\n{cond}\
+         vehicle = \"{}\"\nclass = 4\nstart_m = 120.0\nseeds = [7, 9]\n{cond}",
+        r.join("vehicles/c80_empty.toml").display()
+    )
+    .replacen("name = \"c\"", "name = \"d\"", 1);
+    let plan = Plan::load(&write(&good)).unwrap();
+    let (d, c) = (&plan.conditions[0], &plan.conditions[1]);
+    assert_eq!(d.seeds, vec![7, 9]);
+    assert_eq!(d.class, Some(4));
+    assert_eq!(d.start_m, Some(120.0));
+    assert!(d.vehicle.ends_with("c80_empty.toml"));
+    assert_eq!(c.seeds, vec![2, 3, 4], "the plan's range");
+    assert!(c.vehicle.ends_with("c80.toml") && c.class.is_none());
+    assert!(plan.dataset.float32);
+    assert_eq!(plan.dataset.channels, ["input", "carbody_acc_y"]);
+    for (bad, expect) in [
+        (format!("{head}{cond}class = 7\n"), "condition[0].class"),
+        (
+            format!("{head}{cond}start_m = -1.0\n"),
+            "condition[0].start_m",
+        ),
+        (
+            format!("{head}{cond}seeds = \"5-1\"\n"),
+            "condition[0].seeds",
+        ),
+        (
+            format!("{head}{cond}seeds = \"a-b\"\n"),
+            "condition[0].seeds",
+        ),
+        (format!("{head}{cond}colour = \"red\"\n"), "colour"),
+        (head.replace("\"2-4\"", "[3, 3]") + &cond, "seeds"),
+        (
+            format!("{head}[dataset]\nchannels = [\"\"]\n{cond}"),
+            "dataset.channels",
+        ),
+    ] {
+        let err = Plan::load(&write(&bad)).unwrap_err().to_string();
+        assert!(
+            err.contains(expect) && err.contains("k.plan.toml"),
+            "{expect}: {err}"
+        );
+    }
+}
+
+/// A float32 data set with a channel subset: only the kept channels, values equal to the
+/// float64 data set's to float32 precision, time still exact; and numpy reads it.
+#[test]
+fn float32_subset_keeps_values_to_float32_precision() {
+    let dir = temp("f32");
+    let r = root();
+    let text = |extra: &str| {
+        format!(
+            "name = \"f\"\nvehicle = \"{}\"\nduration_s = 0.3\nseeds = [1]\n{extra}\
+             [[condition]]\nname = \"t\"\ntrack = \"{}\"\nspeed_kmh = 80.0\nclass = 4\nstart_m = 15.0\n",
+            r.join("vehicles/c80.toml").display(),
+            r.join("tracks/tangent.toml").display()
+        )
+    };
+    let p64 = dir.join("a.plan.toml");
+    let p32 = dir.join("b.plan.toml");
+    std::fs::write(&p64, text("")).unwrap();
+    std::fs::write(
+        &p32,
+        text("[dataset]\nchannels = [\"input\", \"deflection\"]\nfloat32 = true\n"),
+    )
+    .unwrap();
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    run_events(&Plan::load(&p64).unwrap(), &opts(&a, Format::Npz, None));
+    let (m, _) = run_events(&Plan::load(&p32).unwrap(), &opts(&b, Format::Npz, None));
+    assert_eq!(m["dataset"]["float32"], true);
+    assert_eq!(m["runs"][0]["class"], 4);
+    let (da, db) = (
+        railforce::features::DataSet::load(&a).unwrap(),
+        railforce::features::DataSet::load(&b).unwrap(),
+    );
+    assert!(db.names.len() < da.names.len());
+    for n in [
+        "time_s",
+        "s_m",
+        "w1l_force_z",
+        "frame_l_acc_y",
+        "frame_l_acc_y_noisy",
+        "pad_sideframe1l_wheelset1_z",
+    ] {
+        assert!(db.channel(n).is_ok(), "{n} kept");
+    }
+    assert!(db.channel("w2r_force_y").is_err(), "wheel forces dropped");
+    for n in [
+        "time_s",
+        "w1l_force_z",
+        "frame_l_acc_y_noisy",
+        "pad_sideframe1l_wheelset1_z",
+    ] {
+        let x = &da.runs[0].columns[da.channel(n).unwrap()];
+        let y = &db.runs[0].columns[db.channel(n).unwrap()];
+        for (u, v) in x.iter().zip(y) {
+            if n == "time_s" {
+                assert_eq!(u, v);
+            } else {
+                assert_eq!(*u as f32 as f64, *v, "{n}");
+            }
+        }
+    }
+    let size = |d: &Path| std::fs::metadata(d.join("t_seed1.npz")).unwrap().len();
+    assert!(size(&b) < size(&a) / 2, "{} vs {}", size(&b), size(&a));
+    if std::process::Command::new("python3")
+        .args(["-c", "import numpy"])
+        .output()
+        .is_ok_and(|o| o.status.success())
+    {
+        let script = format!(
+            "import numpy as np\nd = np.load(r'{}')\nassert d['w1l_force_z'].dtype == np.float32\nassert d['time_s'].dtype == np.float64\nprint('ok')",
+            b.join("t_seed1.npz").display()
+        );
+        let out = std::process::Command::new("python3")
+            .args(["-c", &script])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    // The folder now holds a float32 data set: the float64 plan is refused there.
+    let err = dataset::generate(
+        &Plan::load(&p64).unwrap(),
+        &opts(&b, Format::Npz, None),
+        &|_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("data-set options") && err.contains("another --out"),
+        "{err}"
+    );
+}

@@ -102,33 +102,69 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     );
     bar.set_prefix(format!("generating {}", plan.name));
     let t0 = std::time::Instant::now();
-    let running = std::sync::Mutex::new(Vec::<String>::new());
+    // On a terminal a progress bar; in a log (Slurm, nohup, CI) one plain line per run with
+    // the count, elapsed time and an estimate of what is left.
+    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let state = std::sync::Mutex::new((Vec::<String>::new(), 0usize, 0usize));
     let on_event = |e: Event| {
-        let mut r = running.lock().expect("lock");
-        match e {
-            Event::Started(f) => r.push(f),
+        let mut st = state.lock().expect("lock");
+        let line = match e {
+            Event::Started(f) => {
+                st.0.push(f);
+                None
+            }
             Event::Skipped(f) => {
-                bar.println(format!("skip {f} (done)"));
-                bar.inc(1);
+                st.2 += 1;
+                Some(format!("skip {f} (already done)"))
             }
             Event::Finished(f, wall) => {
-                r.retain(|x| *x != f);
-                bar.println(format!("done {f} in {wall:.1} s"));
-                bar.inc(1);
+                st.0.retain(|x| *x != f);
+                st.1 += 1;
+                Some(format!("done {f} in {wall:.1} s"))
             }
+        };
+        let Some(line) = line else {
+            bar.set_message(st.0.join(" "));
+            return;
+        };
+        if tty {
+            bar.println(line);
+            bar.inc(1);
+            bar.set_message(st.0.join(" "));
+        } else {
+            let (done, elapsed) = (st.1 + st.2, t0.elapsed().as_secs_f64());
+            let eta = if st.1 > 0 {
+                format!(
+                    ", about {:.0} s left",
+                    elapsed / st.1 as f64 * (total - done) as f64
+                )
+            } else {
+                String::new()
+            };
+            eprintln!("[{done}/{total}] {line} ({elapsed:.0} s{eta})");
         }
-        bar.set_message(r.join(" "));
     };
+    if !tty {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
     let result = dataset::generate(&plan, &opts, &on_event);
     bar.finish_and_clear();
     let manifest = result?;
-    println!(
-        "{} runs in {} ({} format) in {:.1} s with {jobs} jobs; manifest: {}",
-        manifest["runs"].as_array().map(|a| a.len()).unwrap_or(0),
-        args.out.display(),
-        format.ext(),
-        t0.elapsed().as_secs_f64(),
-        dataset::manifest_path(&opts).display()
-    );
+    let (_, generated, skipped) = *state.lock().expect("lock");
+    let runs = manifest["runs"].as_array().map(|a| a.len()).unwrap_or(0);
+    if generated == 0 && skipped > 0 {
+        println!(
+            "nothing to do: all {skipped} runs are already in {} with the same settings (delete a run file to redo it)",
+            args.out.display()
+        );
+    } else {
+        println!(
+            "{runs} runs in {} ({} format): {generated} generated, {skipped} skipped (already done), {:.1} s with {jobs} jobs; manifest: {}",
+            args.out.display(),
+            format.ext(),
+            t0.elapsed().as_secs_f64(),
+            dataset::manifest_path(&opts).display()
+        );
+    }
     Ok(())
 }

@@ -8,6 +8,7 @@ pub mod npz;
 pub mod parquet_file;
 
 use crate::error::{Error, Result};
+use crate::plan::DatasetOptions;
 use crate::plan::{Condition, Plan};
 use crate::sensors::{ChannelKind, NoiseModel, PAPER_CHANNELS, label_channels, noisy_name};
 use crate::sim::output::{self, Recording};
@@ -102,6 +103,37 @@ pub fn runs(plan: &Plan) -> Vec<RunSpec> {
     out
 }
 
+/// Columns a float32 data set still stores as float64: time and track position (f32 would
+/// lose the sample time after about a minute and the position to centimetres).
+pub fn keeps_f64(name: &str) -> bool {
+    name == "time_s" || name == "s_m"
+}
+
+/// Whether the channel `name` (of `kind`) is kept by a plan's channel subset: time, position
+/// and the labels always; otherwise when the subset names it, its kind, or (for a noisy copy)
+/// the channel it copies.
+fn kept(name: &str, kind: ChannelKind, subset: &[String]) -> bool {
+    if let (ChannelKind::InputNoisy, Some(base)) = (kind, name.strip_suffix("_noisy"))
+        && kept(base, ChannelKind::Input, subset)
+    {
+        return true;
+    }
+    subset.is_empty()
+        || matches!(kind, ChannelKind::Axis | ChannelKind::Label)
+        || subset.iter().any(|k| k == name || k == kind.name())
+}
+
+/// The kinds a plan's `dataset.channels` may name.
+pub const CHANNEL_KINDS: [&str; 7] = [
+    "axis",
+    "input",
+    "input_noisy",
+    "label",
+    "wheel",
+    "body",
+    "deflection",
+];
+
 /// FNV-1a 64 of bytes, hex.
 pub fn fnv1a(bytes: &[u8]) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -150,10 +182,27 @@ pub fn file_hash(path: &Path) -> Result<String> {
 }
 
 /// Definition of a run for resuming: changes whenever anything that shapes its data changes.
-fn run_key(run: &RunSpec, opts: &GenerateOptions, track_hash: &str, vehicle_hash: &str) -> String {
+fn run_key(
+    run: &RunSpec,
+    opts: &GenerateOptions,
+    track_hash: &str,
+    vehicle_hash: &str,
+    dataset: &DatasetOptions,
+) -> String {
+    // Options added later enter the key only when set, so existing data sets keep their keys.
+    let mut extra = String::new();
+    if let Some(c) = run.condition.class {
+        extra += &format!("|class={c}");
+    }
+    if let Some(s) = run.condition.start_m {
+        extra += &format!("|start={s}");
+    }
+    if *dataset != DatasetOptions::default() {
+        extra += &format!("|dataset={dataset:?}");
+    }
     fnv1a(
         format!(
-            "{}|{}|{}|{}|{}|{}|{:?}|{}|{}|{}",
+            "{}|{}|{}|{}|{}|{}|{:?}|{}|{}|{}{extra}",
             run.condition.name,
             track_hash,
             vehicle_hash,
@@ -229,10 +278,47 @@ pub fn generate(
             n.snr_db
         )));
     }
+    let dataset = &plan.dataset;
+    for c in &dataset.channels {
+        // Every channel name has an underscore (`ws1_acc_z`); a bare word must be a kind.
+        if c.contains('_') || CHANNEL_KINDS.contains(&c.as_str()) {
+            continue;
+        }
+        return Err(Error::config(
+            &plan.source,
+            "dataset.channels",
+            format!(
+                "\"{c}\" is neither a channel name nor a kind ({})",
+                CHANNEL_KINDS.join(", ")
+            ),
+        ));
+    }
+    let manifest_file = manifest_path(opts);
+    let previous = read_manifest(&manifest_file)?;
+    refuse_mixing(&manifest_file, previous.as_ref(), opts, dataset)?;
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
     let vehicle = Vehicle::load(&plan.vehicle)?;
     let labels = label_channels(&vehicle.label_wheel_name());
-    let vehicle_hash = file_hash(&plan.vehicle)?;
+    // Every vehicle the plan's conditions use, loaded and checked once.
+    let mut vehicles: Vec<(PathBuf, Vehicle, String)> = Vec::new();
+    for c in &plan.conditions {
+        if vehicles.iter().any(|v| v.0 == c.vehicle) {
+            continue;
+        }
+        let v = Vehicle::load(&c.vehicle)?;
+        if label_channels(&v.label_wheel_name()) != labels {
+            return Err(Error::Domain(format!(
+                "condition {}: its vehicle {} labels wheel {}, the plan's {} labels {}: one data set has one label wheel",
+                c.name,
+                c.vehicle.display(),
+                v.label_wheel_name(),
+                plan.vehicle.display(),
+                vehicle.label_wheel_name()
+            )));
+        }
+        let hash = file_hash(&c.vehicle)?;
+        vehicles.push((c.vehicle.clone(), v, hash));
+    }
     // Check every track before any run (a bad file should fail now, not after an hour).
     let mine: Vec<RunSpec> = runs(plan)
         .into_iter()
@@ -240,23 +326,46 @@ pub fn generate(
         .collect();
     let mut tracks = Vec::new();
     for r in &mine {
-        let spec = TrackSpec::load(&r.condition.track)?;
+        let mut spec = TrackSpec::load(&r.condition.track)?;
+        if let Some(class) = r.condition.class {
+            set_class(&mut spec, class).map_err(|m| {
+                Error::config(
+                    &plan.source,
+                    format!("condition {}.class", r.condition.name),
+                    m,
+                )
+            })?;
+        }
+        if let Some(s) = r.condition.start_m
+            && s > spec.length()
+        {
+            return Err(Error::config(
+                &plan.source,
+                format!("condition {}.start_m", r.condition.name),
+                format!(
+                    "{s} m is beyond the end of {} ({:.0} m)",
+                    r.condition.track.display(),
+                    spec.length()
+                ),
+            ));
+        }
         tracks.push((spec, file_hash(&r.condition.track)?));
     }
-    let manifest_file = manifest_path(opts);
-    let previous = read_manifest(&manifest_file)?;
     let done: Vec<Value> = previous
         .as_ref()
         .and_then(|m| m.get("runs").and_then(|r| r.as_array()).cloned())
         .unwrap_or_default();
-    vehicle.contact.table(); // build once, before the threads
+    for (_, v, _) in &vehicles {
+        v.contact.table(); // build once, before the threads
+    }
     let manifest = Mutex::new(json!({
         "tool": format!("railforce {}", env!("CARGO_PKG_VERSION")),
         "plan": plan.source,
         "plan_name": plan.name,
-        "vehicle": {"file": plan.vehicle, "hash_fnv1a": vehicle_hash, "name": vehicle.name},
+        "vehicle": {"file": plan.vehicle, "hash_fnv1a": file_hash(&plan.vehicle)?, "name": vehicle.name},
         "format": opts.format.ext(),
         "sampling_rate_hz": SimConfig::default().output_rate,
+        "dataset": dataset,
         "snr_db": opts.noise.map(|n| n.snr_db),
         "snr_reference": opts.noise.map(|n| n.reference.name()),
         "noise": opts.noise.map(|n| format!("{}; the paper's input channels only (suffix _noisy), clean channels always kept", n.describe())),
@@ -277,7 +386,11 @@ pub fn generate(
     let work = |k: usize| -> Result<()> {
         let run = &mine[k];
         let (spec, track_hash) = &tracks[k];
-        let key = run_key(run, opts, track_hash, &vehicle_hash);
+        let (_, vehicle, vehicle_hash) = vehicles
+            .iter()
+            .find(|v| v.0 == run.condition.vehicle)
+            .expect("every condition's vehicle is loaded");
+        let key = run_key(run, opts, track_hash, vehicle_hash, dataset);
         let file = run.file_name(opts.format);
         let path = opts.out.join(&file);
         if let Some(entry) = done.iter().find(|e| e["key"] == key.as_str())
@@ -300,9 +413,10 @@ pub fn generate(
             speed: run.condition.speed(),
             duration: run.condition.duration,
             settle: opts.settle,
+            start: run.condition.start_m,
             ..SimConfig::default()
         };
-        let mut sim = Simulation::new(&vehicle, &track, cfg)
+        let mut sim = Simulation::new(vehicle, &track, cfg)
             .map_err(|e| Error::Domain(format!("{}: {e}", run.condition.name)))?;
         let mut rec = output::record(&mut sim, |_| {}).map_err(|e| {
             Error::Domain(format!("{} (seed {}): {e}", run.condition.name, run.seed))
@@ -310,7 +424,9 @@ pub fn generate(
         if let Some(noise) = opts.noise {
             add_noise(&mut rec, &noise, run.seed);
         }
-        write_run(&path, &rec, opts.format)?;
+        keep_channels(&mut rec, &labels, &dataset.channels)
+            .map_err(|m| Error::config(&plan.source, "dataset.channels", m))?;
+        write_run(&path, &rec, opts.format, dataset.float32)?;
         let bytes_hash = file_hash(&path)?;
         let entry = json!({
             "key": key,
@@ -321,11 +437,26 @@ pub fn generate(
             "track": {"file": run.condition.track, "hash_fnv1a": track_hash, "name": spec.name},
             "speed_kmh": run.condition.speed_kmh,
             "duration_s": run.condition.duration,
+            "vehicle": vehicle.name,
+            "class": run.condition.class,
+            "start_m": run.condition.start_m,
             "rows": rec.rows.len(),
             "wall_time_s": rec.summary.wall,
             "peak_y_over_q": rec.summary.peak_y_over_q,
         });
         let mut m = manifest.lock().expect("manifest lock");
+        if !m["channels"].is_null() {
+            let names: Vec<&str> = m["channels"]
+                .as_array()
+                .map(|a| a.iter().filter_map(|c| c["name"].as_str()).collect())
+                .unwrap_or_default();
+            if names != rec.names.iter().map(|n| n.as_str()).collect::<Vec<_>>() {
+                return Err(Error::Domain(format!(
+                    "{} (vehicle {}) records other channels than the data set's first run: one data set has one set of channels",
+                    run.condition.name, vehicle.name
+                )));
+            }
+        }
         if m["channels"].is_null() {
             m["channels"] = rec
                 .names
@@ -382,6 +513,112 @@ fn sort_runs(m: &mut Value) {
     }
 }
 
+/// Refuses to add runs to a folder whose data set was written in another format, at another
+/// SNR or with other data-set options: one folder, one data set.
+fn refuse_mixing(
+    manifest: &Path,
+    previous: Option<&Value>,
+    opts: &GenerateOptions,
+    dataset: &DatasetOptions,
+) -> Result<()> {
+    let Some(m) = previous else {
+        return Ok(());
+    };
+    let snr = |v: Option<f64>| v.map_or("clean".to_string(), |s| format!("{s} dB"));
+    let (had_format, had_snr) = (m["format"].as_str().unwrap_or("?"), m["snr_db"].as_f64());
+    let had_ref = m["snr_reference"].as_str();
+    let now_ref = opts.noise.map(|n| n.reference.name());
+    let mut differ = Vec::new();
+    if had_format != opts.format.ext() {
+        differ.push(format!("format {had_format} (now {})", opts.format.ext()));
+    }
+    if had_snr != opts.noise.map(|n| n.snr_db) || (had_snr.is_some() && had_ref != now_ref) {
+        differ.push(format!(
+            "noise {}{} (now {}{})",
+            snr(had_snr),
+            had_ref
+                .map(|r| format!(", σ from the {r}"))
+                .unwrap_or_default(),
+            snr(opts.noise.map(|n| n.snr_db)),
+            now_ref
+                .map(|r| format!(", σ from the {r}"))
+                .unwrap_or_default(),
+        ));
+    }
+    let had_ds = &m["dataset"];
+    let now_ds = serde_json::to_value(dataset).expect("options serialise");
+    if !(had_ds == &now_ds || (had_ds.is_null() && *dataset == DatasetOptions::default())) {
+        differ.push(format!("data-set options {had_ds} (now {now_ds})"));
+    }
+    if differ.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Domain(format!(
+        "{} holds a data set with {}: write to another --out folder, or delete that folder to start again (runs are never mixed)",
+        manifest.display(),
+        differ.join(" and ")
+    )))
+}
+
+/// The irregularity class of a track replaced by `class` (1–6); the gauge limits follow the
+/// class unless the track file set its own.
+fn set_class(spec: &mut TrackSpec, class: i64) -> std::result::Result<(), String> {
+    let new = crate::track::FraClass::new(class).ok_or(format!("unknown FRA class {class}"))?;
+    let irr = spec.irregularity.as_mut().ok_or(format!(
+        "{} has no [irregularity] table to take a class",
+        spec.source.display()
+    ))?;
+    if irr.gauge_limits == irr.class.gauge_limits() {
+        irr.gauge_limits = new.gauge_limits();
+    }
+    irr.class = new;
+    Ok(())
+}
+
+/// Drops the channels a plan's subset does not keep (see [`kept`]).
+fn keep_channels(
+    rec: &mut Recording,
+    labels: &[String; 2],
+    subset: &[String],
+) -> std::result::Result<(), String> {
+    if subset.is_empty() {
+        return Ok(());
+    }
+    let kinds: Vec<ChannelKind> = rec
+        .names
+        .iter()
+        .map(|n| ChannelKind::of(n, labels))
+        .collect();
+    for k in subset {
+        let named = rec.names.iter().any(|n| n == k) || CHANNEL_KINDS.contains(&k.as_str());
+        if !named {
+            return Err(format!(
+                "\"{k}\" is neither a channel of this vehicle nor a kind ({}); channels are listed by `railforce simulate --list-channels`",
+                CHANNEL_KINDS.join(", ")
+            ));
+        }
+    }
+    let keep: Vec<bool> = rec
+        .names
+        .iter()
+        .zip(&kinds)
+        .map(|(n, k)| kept(n, *k, subset))
+        .collect();
+    fn pick<T>(v: &mut Vec<T>, keep: &[bool]) {
+        let mut i = 0;
+        v.retain(|_| {
+            i += 1;
+            keep[i - 1]
+        })
+    }
+    pick(&mut rec.names, &keep);
+    pick(&mut rec.units, &keep);
+    for row in &mut rec.rows {
+        pick(row, &keep);
+    }
+    Ok(())
+}
+
 /// Appends `<name>_noisy` copies of the paper's input channels.
 fn add_noise(rec: &mut Recording, noise: &NoiseModel, seed: u64) {
     let inputs: Vec<(usize, String)> = rec
@@ -402,9 +639,12 @@ fn add_noise(rec: &mut Recording, noise: &NoiseModel, seed: u64) {
 }
 
 /// Writes a recording in a format, atomically.
-pub fn write_run(path: &Path, rec: &Recording, format: Format) -> Result<()> {
+pub fn write_run(path: &Path, rec: &Recording, format: Format, float32: bool) -> Result<()> {
     match format {
-        Format::Csv => crate::io::write_atomic(path, |w| rec.write_csv(w)),
+        Format::Csv => {
+            let single: Vec<bool> = rec.names.iter().map(|n| float32 && !keeps_f64(n)).collect();
+            crate::io::write_atomic(path, |w| rec.write_csv_as(w, &single))
+        }
         Format::Npz | Format::Parquet => {
             let cols: Vec<Vec<f64>> = (0..rec.names.len()).map(|i| rec.column(i)).collect();
             let named: Vec<(&str, &[f64])> = rec
@@ -414,9 +654,9 @@ pub fn write_run(path: &Path, rec: &Recording, format: Format) -> Result<()> {
                 .zip(cols.iter().map(|c| c.as_slice()))
                 .collect();
             if format == Format::Npz {
-                crate::io::write_atomic(path, |w| npz::write_npz(w, &named))
+                crate::io::write_atomic(path, |w| npz::write_npz(w, &named, float32))
             } else {
-                let bytes = parquet_file::write_parquet(&named).map_err(|e| {
+                let bytes = parquet_file::write_parquet(&named, float32).map_err(|e| {
                     Error::Domain(format!("{}: Parquet encoding failed: {e}", path.display()))
                 })?;
                 crate::io::write_atomic(path, |w| w.write_all(&bytes))

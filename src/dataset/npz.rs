@@ -29,10 +29,11 @@ fn crc32(data: &[u8]) -> u32 {
     c ^ 0xFFFF_FFFF
 }
 
-/// A 1-D little-endian float64 `.npy` file.
-fn npy(values: &[f64]) -> Vec<u8> {
+/// A 1-D little-endian float64 (or float32) `.npy` file.
+fn npy(values: &[f64], single: bool) -> Vec<u8> {
     let mut header = format!(
-        "{{'descr': '<f8', 'fortran_order': False, 'shape': ({},), }}",
+        "{{'descr': '{}', 'fortran_order': False, 'shape': ({},), }}",
+        if single { "<f4" } else { "<f8" },
         values.len()
     );
     // Magic (6) + version (2) + length (2) + header + '\n' must be a multiple of 64.
@@ -44,18 +45,23 @@ fn npy(values: &[f64]) -> Vec<u8> {
     out.extend_from_slice(&(header.len() as u16).to_le_bytes());
     out.extend_from_slice(header.as_bytes());
     for v in values {
-        out.extend_from_slice(&v.to_le_bytes());
+        if single {
+            out.extend_from_slice(&(*v as f32).to_le_bytes());
+        } else {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
     }
     out
 }
 
-/// Writes named columns as an NPZ archive.
-pub fn write_npz(w: &mut dyn Write, columns: &[(&str, &[f64])]) -> io::Result<()> {
+/// Writes named columns as an NPZ archive; with `float32`, every column but time and
+/// position ([`super::keeps_f64`]) is stored as float32.
+pub fn write_npz(w: &mut dyn Write, columns: &[(&str, &[f64])], float32: bool) -> io::Result<()> {
     let mut offset: u64 = 0;
     let mut central = Vec::new();
     let mut count: u16 = 0;
     for (name, values) in columns {
-        let data = npy(values);
+        let data = npy(values, float32 && !super::keeps_f64(name));
         let fname = format!("{name}.npy");
         let crc = crc32(&data);
         let size = u32::try_from(data.len())
@@ -144,12 +150,26 @@ pub fn read_npz(bytes: &[u8]) -> io::Result<Vec<(String, Vec<f64>)>> {
         if !data.starts_with(b"\x93NUMPY") {
             return Err(bad("entry is not a .npy array"));
         }
+        if data.len() < 10 {
+            return Err(bad("truncated .npy header"));
+        }
         let hlen = u16_at(data, 8);
+        let header = data
+            .get(10..10 + hlen)
+            .ok_or_else(|| bad("truncated .npy header"))?;
+        let header = String::from_utf8_lossy(header);
         let body = &data[10 + hlen..];
-        let values = body
-            .chunks_exact(8)
-            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-            .collect();
+        let values = if header.contains("'<f4'") {
+            body.chunks_exact(4)
+                .map(|c| f64::from(f32::from_le_bytes(c.try_into().expect("4 bytes"))))
+                .collect()
+        } else if header.contains("'<f8'") {
+            body.chunks_exact(8)
+                .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+                .collect()
+        } else {
+            return Err(bad("entry is neither float64 nor float32"));
+        };
         out.push((name, values));
         p = data_start + size;
     }

@@ -1,9 +1,10 @@
-//! Parquet writer: one required DOUBLE column per channel, one row group, no compression (the
+//! Parquet writer: one required DOUBLE (or FLOAT, for float32 data sets) column per channel,
+//! one row group, no compression (the
 //! crate's codecs stay out of the build); pandas, polars and pyarrow read it directly
 //! (`pd.read_parquet("run.parquet")`).
 
 use parquet::basic::{Repetition, Type as PhysicalType};
-use parquet::data_type::DoubleType;
+use parquet::data_type::{DoubleType, FloatType};
 use parquet::errors::ParquetError;
 use parquet::file::properties::WriterProperties;
 use parquet::file::reader::{FileReader, SerializedFileReader};
@@ -11,12 +12,19 @@ use parquet::file::writer::SerializedFileWriter;
 use parquet::schema::types::Type;
 use std::sync::Arc;
 
-/// Encodes named columns as a Parquet file in memory.
-pub fn write_parquet(columns: &[(&str, &[f64])]) -> Result<Vec<u8>, ParquetError> {
+/// Encodes named columns as a Parquet file in memory; with `float32`, every column but time and
+/// position ([`super::keeps_f64`]) is FLOAT.
+pub fn write_parquet(columns: &[(&str, &[f64])], float32: bool) -> Result<Vec<u8>, ParquetError> {
+    let single = |name: &str| float32 && !super::keeps_f64(name);
     let fields = columns
         .iter()
         .map(|(name, _)| {
-            Type::primitive_type_builder(name, PhysicalType::DOUBLE)
+            let t = if single(name) {
+                PhysicalType::FLOAT
+            } else {
+                PhysicalType::DOUBLE
+            };
+            Type::primitive_type_builder(name, t)
                 .with_repetition(Repetition::REQUIRED)
                 .build()
                 .map(Arc::new)
@@ -39,7 +47,12 @@ pub fn write_parquet(columns: &[(&str, &[f64])]) -> Result<Vec<u8>, ParquetError
         let mut col = group
             .next_column()?
             .ok_or_else(|| ParquetError::General(format!("no column writer for {name}")))?;
-        col.typed::<DoubleType>().write_batch(values, None, None)?;
+        if single(name) {
+            let v: Vec<f32> = values.iter().map(|&x| x as f32).collect();
+            col.typed::<FloatType>().write_batch(&v, None, None)?;
+        } else {
+            col.typed::<DoubleType>().write_batch(values, None, None)?;
+        }
         col.close()?;
     }
     group.close()?;
@@ -61,9 +74,10 @@ pub fn read_parquet(bytes: Vec<u8>) -> Result<Vec<(String, Vec<f64>)>, ParquetEr
         for (k, (_, field)) in row.get_column_iter().enumerate() {
             match field {
                 parquet::record::Field::Double(v) => cols[k].1.push(*v),
+                parquet::record::Field::Float(v) => cols[k].1.push(f64::from(*v)),
                 other => {
                     return Err(ParquetError::General(format!(
-                        "column {} is not DOUBLE: {other:?}",
+                        "column {} is neither DOUBLE nor FLOAT: {other:?}",
                         cols[k].0
                     )));
                 }
@@ -81,7 +95,7 @@ mod tests {
     fn parquet_round_trip() {
         let a = [1.0, -2.5, 1e300];
         let b = [0.0, 0.1, 0.2];
-        let bytes = write_parquet(&[("a", &a), ("b_x", &b)]).unwrap();
+        let bytes = write_parquet(&[("a", &a), ("b_x", &b)], false).unwrap();
         assert_eq!(&bytes[..4], b"PAR1");
         let back = read_parquet(bytes.clone()).unwrap();
         assert_eq!(
@@ -91,7 +105,19 @@ mod tests {
                 ("b_x".to_string(), b.to_vec())
             ]
         );
+        // float32: values to f32 precision, time kept f64.
+        let t = [0.005, 1e-9 + 0.01];
+        let single = write_parquet(&[("a", &b), ("time_s", &t)], true).unwrap();
+        let back = read_parquet(single).unwrap();
+        assert_eq!(
+            back[0].1,
+            b.iter().map(|&x| x as f32 as f64).collect::<Vec<_>>()
+        );
+        assert_eq!(back[1].1, t.to_vec());
         // Deterministic bytes.
-        assert_eq!(bytes, write_parquet(&[("a", &a), ("b_x", &b)]).unwrap());
+        assert_eq!(
+            bytes,
+            write_parquet(&[("a", &a), ("b_x", &b)], false).unwrap()
+        );
     }
 }

@@ -279,15 +279,23 @@ impl Recording {
 
     /// Writes the rows as CSV with a header line.
     pub fn write_csv(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        self.write_csv_as(w, &[])
+    }
+
+    /// CSV with the columns flagged in `single` (by index; missing: false) printed at float32
+    /// precision (the shortest text that reads back as the same f32).
+    pub fn write_csv_as(&self, w: &mut dyn Write, single: &[bool]) -> std::io::Result<()> {
         writeln!(w, "{}", self.names.join(","))?;
         for row in &self.rows {
-            let mut first = true;
-            for x in row {
-                if !first {
+            for (k, x) in row.iter().enumerate() {
+                if k > 0 {
                     w.write_all(b",")?;
                 }
-                first = false;
-                write!(w, "{x:.7e}")?;
+                if single.get(k).copied().unwrap_or(false) {
+                    write!(w, "{:e}", *x as f32)?;
+                } else {
+                    write!(w, "{x:.7e}")?;
+                }
             }
             w.write_all(b"\n")?;
         }
