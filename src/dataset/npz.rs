@@ -190,13 +190,13 @@ mod tests {
         let a = [1.0, -2.5, f64::MAX];
         let b: Vec<f64> = (0..1000).map(|i| i as f64 * 0.1).collect();
         let mut buf = Vec::new();
-        write_npz(&mut buf, &[("a", &a), ("b_long_name", &b)]).unwrap();
+        write_npz(&mut buf, &[("a", &a), ("b_long_name", &b)], false).unwrap();
         let back = read_npz(&buf).unwrap();
         assert_eq!(back[0].0, "a");
         assert_eq!(back[0].1, a);
         assert_eq!(back[1].1, b);
         assert_eq!(
-            (10 + u16::from_le_bytes([npy(&a)[8], npy(&a)[9]]) as usize) % 64,
+            (10 + u16::from_le_bytes([npy(&a, false)[8], npy(&a, false)[9]]) as usize) % 64,
             0
         );
     }
