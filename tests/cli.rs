@@ -360,3 +360,146 @@ fn demo_runs_from_an_empty_folder() {
     assert!(links >= 20, "{links} links");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// On-board identification of both wheels of the leading wheelset: a list of targets gives
+/// Y/Q of each wheel and the wheelset's H; streaming and batch write the same file, with the
+/// track position carried through and ASCII column names.
+#[test]
+fn identify_both_wheels_streaming_equals_batch() {
+    let plan = tmp("wheels.plan.toml");
+    let root = env!("CARGO_MANIFEST_DIR");
+    std::fs::write(
+        &plan,
+        format!(
+            "name = \"wheels\"\nvehicle = \"{root}/vehicles/c80.toml\"\nduration_s = 0.5\nseeds = [1, 2, 3]\n\
+             [[condition]]\nname = \"curve\"\ntrack = \"{root}/tracks/curve_r400.toml\"\nspeed_kmh = 60.0\n"
+        ),
+    )
+    .unwrap();
+    let data = tmp("wheels_data");
+    let (ok, _, err) = railforce(&[
+        "generate",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--out",
+        data.to_str().unwrap(),
+        "--format",
+        "csv",
+        "--snr-db",
+        "6",
+        "--settle",
+        "0.1",
+    ]);
+    assert!(ok, "{err}");
+    let model = tmp("wheels_model");
+    let (ok, _, err) = railforce(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        "gru",
+        "--epochs",
+        "1",
+        "--target",
+        "w1l,1R",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = railforce(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        "gru",
+        "--target",
+        "FX",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("unknown target FX") && err.contains("w1l"),
+        "{err}"
+    );
+    let input = data.join("curve_seed3.csv");
+    let batch = tmp("wheels_batch.csv");
+    let (ok, _, err) = railforce(&[
+        "identify",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        batch.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("H wheelset 1 (kN)"), "{err}");
+    let streamed = tmp("wheels_stream.csv");
+    let out = Command::new(env!("CARGO_BIN_EXE_railforce"))
+        .args([
+            "identify",
+            "--model",
+            model.to_str().unwrap(),
+            "--input",
+            "-",
+            "--out",
+        ])
+        .arg(&streamed)
+        .stdin(std::fs::File::open(&input).unwrap())
+        .output()
+        .unwrap();
+    let serr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{serr}");
+    assert!(
+        serr.contains("H wheelset 1 (kN)"),
+        "the exceedance report: {serr}"
+    );
+    let (a, b) = (
+        std::fs::read_to_string(&batch).unwrap(),
+        std::fs::read_to_string(&streamed).unwrap(),
+    );
+    assert_eq!(
+        a.lines().next().unwrap(),
+        "time_s,s_m,w1l_force_y_N,w1l_force_z_N,w1r_force_y_N,w1r_force_z_N,\
+         y_over_q_w1l,unloading_w1l,y_over_q_w1r,unloading_w1r,h_wheelset1_kn"
+    );
+    assert!(a.is_ascii());
+    assert_eq!(a, b, "streaming and batch write the same file");
+    assert!(batch.with_extension("safety.json").exists());
+    assert!(streamed.with_extension("safety.json").exists());
+    // One error format: a NaN in the stream is named by column and row like the batch reader.
+    let text = std::fs::read_to_string(&input).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let k = lines[0]
+        .split(',')
+        .position(|c| c == "frame_l_acc_y_noisy")
+        .unwrap();
+    let mut f: Vec<String> = lines[5].split(',').map(str::to_string).collect();
+    f[k] = "NaN".into();
+    lines[5] = f.join(",");
+    let bad = tmp("wheels_nan.csv");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    let (ok, _, err_batch) = railforce(&[
+        "identify",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        bad.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    let out = Command::new(env!("CARGO_BIN_EXE_railforce"))
+        .args([
+            "identify",
+            "--model",
+            model.to_str().unwrap(),
+            "--input",
+            "-",
+        ])
+        .stdin(std::fs::File::open(&bad).unwrap())
+        .output()
+        .unwrap();
+    let err_stream = String::from_utf8_lossy(&out.stderr);
+    for e in [&err_batch, &err_stream.to_string()] {
+        assert!(e.contains("column frame_l_acc_y_noisy, row 5"), "{e}");
+    }
+}

@@ -22,8 +22,10 @@ pub struct DataArgs {
     /// all 21 paper channels, window 20, label at the last step.
     #[arg(long)]
     pub selection: Option<PathBuf>,
-    /// Target: FL (lateral force of the vehicle's label wheel, 1L for the C80), FQ (vertical),
-    /// both, or a label channel name.
+    /// Targets, comma separated: FL (lateral force of the vehicle's label wheel, 1L for the
+    /// C80), FQ (vertical), both, a wheel (`w1r` or `1R`: its Y and Q), or a channel name.
+    /// `--target w1l,w1r` identifies both wheels of the leading wheelset: Y/Q of each and the
+    /// wheelset's lateral force H.
     #[arg(long, default_value = "both")]
     pub target: String,
     /// Noise protocol: clean, train-clean-test-noisy, or matched (train and test on the
@@ -134,10 +136,7 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
             *c = base.to_string();
         }
     }
-    let targets: Vec<String> = match args.target.as_str() {
-        "both" => ds.labels.to_vec(),
-        t => vec![ds.target_channel(t)],
-    };
+    let targets = ds.targets(&args.target)?;
     // A noised data set (generate --snr-db) trains on noisy inputs; copies it lacks (the
     // on-board candidates) are drawn in memory with its noise model (see `with_noisy_copies`).
     let has_noisy = ds.noise.is_some()

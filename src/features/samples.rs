@@ -67,6 +67,45 @@ impl DataSet {
         }
     }
 
+    /// The label channels a target list names (comma separated): `FL`, `FQ`, `both`, a wheel
+    /// (`w2r` or `2R`: its Y and Q), or a channel name; in the order given, without repeats.
+    /// Unknown names are refused with what is accepted.
+    pub fn targets(&self, list: &str) -> Result<Vec<String>> {
+        let mut out: Vec<String> = Vec::new();
+        for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let wheel = item.to_ascii_lowercase();
+            let wheel = if wheel.len() == 2 && wheel.as_bytes()[0].is_ascii_digit() {
+                format!("w{wheel}")
+            } else {
+                wheel
+            };
+            let names: Vec<String> = match item {
+                "both" => self.labels.to_vec(),
+                "FL" | "FQ" => vec![self.target_channel(item)],
+                _ if self.channel(&format!("{wheel}_force_y")).is_ok() => {
+                    vec![format!("{wheel}_force_y"), format!("{wheel}_force_z")]
+                }
+                _ if self.channel(item).is_ok() && !crate::sensors::is_noisy(item) => {
+                    vec![item.to_string()]
+                }
+                _ => {
+                    return Err(Error::Domain(format!(
+                        "unknown target {item}: use FL, FQ, both, a wheel (w1l … w4r, or 1L … 4R) or a channel such as w2r_force_y, comma separated"
+                    )));
+                }
+            };
+            for n in names {
+                if !out.contains(&n) {
+                    out.push(n);
+                }
+            }
+        }
+        if out.is_empty() {
+            return Err(Error::Domain("no target given".into()));
+        }
+        Ok(out)
+    }
+
     /// Resolves `FL`/`FQ` to this data set's label channels; any other name is a channel.
     pub fn target_channel(&self, target: &str) -> String {
         match target {

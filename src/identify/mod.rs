@@ -114,6 +114,8 @@ pub struct CheckedInput {
     pub time: Vec<f64>,
     /// Columns in model order.
     pub columns: Vec<Vec<f64>>,
+    /// The track position `s_m` where the table has it (resampled with the rest).
+    pub position: Option<Vec<f64>>,
 }
 
 /// Checks a table against a model: every channel present (the `_noisy` copy where the model's
@@ -156,6 +158,17 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
             r + 1
         )));
     }
+    let position = table.column("s_m").map(<[f64]>::to_vec);
+    if let Some(r) = position
+        .as_ref()
+        .and_then(|p| p.iter().position(|x| !x.is_finite()))
+    {
+        return Err(Error::Domain(format!(
+            "{}: column s_m, row {}: value is not a finite number",
+            table.source,
+            r + 1
+        )));
+    }
     let dt = 1.0 / RATE_HZ;
     let bad = t.windows(2).position(|w| !is_regular_step(w[1] - w[0]));
     match bad {
@@ -163,6 +176,7 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
             used,
             time: t.clone(),
             columns,
+            position,
         }),
         Some(r) if !resample => {
             let step = t[r + 1] - t[r];
@@ -191,10 +205,12 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
             let n = ((t[t.len() - 1] - t[0]) / dt).floor() as usize + 1;
             let new_t: Vec<f64> = (0..n).map(|i| t[0] + i as f64 * dt).collect();
             let columns = columns.iter().map(|c| interpolate(t, c, &new_t)).collect();
+            let position = position.map(|p| interpolate(t, &p, &new_t));
             Ok(CheckedInput {
                 used,
                 time: new_t,
                 columns,
+                position,
             })
         }
     }
@@ -268,6 +284,15 @@ fn finish(model: &Model, time: &[f64], out: Vec<f32>, count: usize) -> Identifie
             })
             .collect(),
     }
+}
+
+/// The values of `series` (one per input sample) at the label time of each complete window,
+/// in the order [`identify`] returns its estimates (e.g. the track position `s_m`).
+pub fn at_labels(model: &Model, series: &[f64]) -> Vec<f64> {
+    let spec = &model.meta.data;
+    let off = label_offset(spec.window, spec.label_at);
+    let count = (series.len() + 1).saturating_sub(spec.window);
+    (0..count).map(|s| series[s + off]).collect()
 }
 
 /// One-sample-at-a-time identification: keeps the last `window` standardised samples and
