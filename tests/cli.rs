@@ -503,3 +503,56 @@ fn identify_both_wheels_streaming_equals_batch() {
         assert!(e.contains("column frame_l_acc_y_noisy, row 5"), "{e}");
     }
 }
+
+/// `contact` rolls by default (no longitudinal force when centred), prints Y/Q, warns past
+/// Nadal's limit, and a sweep's row at y = 0 is the single state's.
+#[test]
+fn contact_rolls_sweeps_and_warns() {
+    let (ok, out, err) = railforce(&["contact", "--vehicle", "vehicles/c80.toml"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("rolling at the mean rolling radius"), "{out}");
+    let fx: Vec<f64> = out
+        .lines()
+        .filter(|l| l.starts_with("left ") || l.starts_with("right "))
+        .map(|l| l.split_whitespace().nth(12).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(fx.len(), 2);
+    assert!(
+        fx.iter().all(|f| f.abs() < 0.01),
+        "Fx {fx:?} kN when centred"
+    );
+    let yq_single: Vec<String> = out
+        .lines()
+        .filter_map(|l| l.split("|Y|/Q ").nth(1))
+        .map(|r| r.split_whitespace().next().unwrap().to_string())
+        .collect();
+    let sweep = tmp("sweep.csv");
+    let (ok, _, err) = railforce(&[
+        "contact",
+        "--vehicle",
+        "vehicles/c80.toml",
+        "--sweep-y",
+        "-10:10:5",
+        "--out",
+        sweep.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("beyond Nadal's flange-climb limit"), "{err}");
+    let text = std::fs::read_to_string(&sweep).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 10);
+    let at0: Vec<String> = rows
+        .iter()
+        .filter(|r| r[0] == "0")
+        .map(|r| format!("{:.3}", r[8].parse::<f64>().unwrap()))
+        .collect();
+    assert_eq!(at0, yq_single, "the sweep's y = 0 is the single state");
+    let (ok, _, err) = railforce(&["contact", "--vehicle", "vehicles/c80.toml", "--y-mm", "10"]);
+    assert!(ok && err.contains("would climb its flange"), "{err}");
+    let (ok, _, err) = railforce(&["contact", "--sweep-y", "5:1:1"]);
+    assert!(!ok && err.contains("FROM ≤ TO"), "{err}");
+}

@@ -85,8 +85,9 @@ pub struct ContactArgs {
     /// Forward speed, km/h.
     #[arg(long, default_value_t = 60.0)]
     speed_kmh: f64,
-    /// Wheelset spin (angular velocity about the axle), rad/s [default: speed / r0, pure
-    /// rolling at the nominal radius].
+    /// Wheelset spin (angular velocity about the axle), rad/s [default: speed over the mean of
+    /// the two wheels' rolling radii at this shift: the wheelset rolls, with no longitudinal
+    /// creep when centred].
     #[arg(long, allow_hyphen_values = true)]
     spin: Option<f64>,
     /// Lateral velocity of the wheelset, m/s.
@@ -104,6 +105,137 @@ pub struct ContactArgs {
     /// Also print the equivalent conicity (EN 15302 integral method) for amplitudes 1–10 mm.
     #[arg(long)]
     conicity: bool,
+    /// Sweep the lateral shift, mm, `FROM:TO:STEP` (e.g. `-12:12:0.5`), writing one row per
+    /// state and wheel to --out (CSV, or JSON when the name ends in .json).
+    #[arg(long, value_name = "FROM:TO:STEP", allow_hyphen_values = true)]
+    sweep_y: Option<String>,
+    /// Sweep the yaw angle, mrad, `FROM:TO:STEP` (with or without --sweep-y).
+    #[arg(long, value_name = "FROM:TO:STEP", allow_hyphen_values = true)]
+    sweep_yaw: Option<String>,
+    /// Output of a sweep [default: contact_sweep.csv].
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// Everything a contact state needs, from the vehicle or the options.
+struct Setup {
+    table: railforce::contact::ContactTable,
+    model: ContactModel,
+    /// Half the wheelset mass (for the contact damping), kg.
+    mass: f64,
+    /// Nominal rolling radius, m.
+    r0: f64,
+    /// Vertical load per wheel, N.
+    load: f64,
+    /// Flange angle for Nadal's limit, rad.
+    flange_angle: f64,
+}
+
+/// One wheel of a solved state.
+struct WheelResult {
+    side: Side,
+    forces: railforce::contact::WheelForces,
+    /// Approach of the wheelset centre below its rigid height, m.
+    approach: f64,
+}
+
+/// The state's rigid roll and height, the spin used, and both wheels' forces.
+struct StateResult {
+    roll: f64,
+    height: f64,
+    spin: f64,
+    /// Mean rolling radius of the two wheels at this shift, m (NaN when the spin was given).
+    rolling_radius: f64,
+    wheels: Vec<WheelResult>,
+}
+
+fn solve(setup: &Setup, args: &ContactArgs, y: f64, yaw: f64) -> StateResult {
+    let rigid = setup.table.lookup(y);
+    let speed = args.speed_kmh / 3.6;
+    let wheels_at = |spin: f64| -> Vec<WheelResult> {
+        [Side::Left, Side::Right]
+            .into_iter()
+            .map(|side| {
+                let mut w = WheelOnRail::rolling(side, speed, setup.r0, 0.0, setup.mass);
+                w.y = y;
+                w.yaw = yaw;
+                w.roll = rigid.roll + args.extra_roll_mrad * 1e-3;
+                w.velocity = [
+                    speed * yaw.cos() - args.lateral_velocity * yaw.sin(),
+                    speed * yaw.sin() + args.lateral_velocity * yaw.cos(),
+                    0.0,
+                ];
+                w.angular_velocity = [-spin * yaw.sin(), spin * yaw.cos(), args.yaw_rate];
+                w.height = height_for_load(&setup.table, &setup.model, &w, setup.load);
+                WheelResult {
+                    side,
+                    forces: evaluate(&setup.table, &setup.model, &w),
+                    approach: rigid.z - w.height,
+                }
+            })
+            .collect()
+    };
+    // Default spin: rolling at the mean of the two wheels' actual rolling radii at this
+    // shift — the load centres of their elastic patches (one refinement from the rigid
+    // contacts' radii) — so a centred wheelset rolls without longitudinal creep.
+    let (spin, rolling_radius, wheels) = match args.spin {
+        Some(spin) => (spin, f64::NAN, wheels_at(spin)),
+        None => {
+            let mut r = 0.5 * (rigid.wheels[0].rolling_radius + rigid.wheels[1].rolling_radius);
+            let mut wheels = wheels_at(speed / r);
+            let radii: Vec<f64> = wheels
+                .iter()
+                .filter_map(|w| w.forces.main().map(|p| p.radius))
+                .collect();
+            if radii.len() == 2 {
+                r = 0.5 * (radii[0] + radii[1]);
+                wheels = wheels_at(speed / r);
+            }
+            (speed / r, r, wheels)
+        }
+    };
+    StateResult {
+        roll: rigid.roll,
+        height: rigid.z,
+        spin,
+        rolling_radius,
+        wheels,
+    }
+}
+
+/// |Y|/Q of a wheel (NaN when it carries no load).
+fn y_over_q(f: &railforce::contact::WheelForces) -> f64 {
+    if f.force[2] > 1.0 {
+        f.force[1].abs() / f.force[2]
+    } else {
+        f64::NAN
+    }
+}
+
+/// Nadal's flange-climb limit for flange angle δ and friction μ.
+fn nadal(delta: f64, mu: f64) -> f64 {
+    let t = delta.tan();
+    (t - mu) / (1.0 + mu * t)
+}
+
+/// Parses `FROM:TO:STEP`.
+fn range(text: &str, what: &str) -> Result<Vec<f64>> {
+    let parts: Vec<f64> = text
+        .split(':')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| anyhow::anyhow!("{what} {text}: expected FROM:TO:STEP, e.g. -10:10:0.5"))?;
+    let [a, b, step] = parts[..] else {
+        bail!("{what} {text}: expected FROM:TO:STEP, e.g. -10:10:0.5");
+    };
+    if !(step > 0.0 && step.is_finite() && a.is_finite() && b.is_finite() && b >= a) {
+        bail!("{what} {text}: FROM ≤ TO and STEP > 0");
+    }
+    let n = ((b - a) / step + 1e-9).floor() as usize + 1;
+    if n > 100_000 {
+        bail!("{what} {text}: {n} points, more than 100 000");
+    }
+    Ok((0..n).map(|i| a + i as f64 * step).collect())
 }
 
 pub fn run(args: ContactArgs) -> Result<()> {
@@ -121,48 +253,65 @@ pub fn run(args: ContactArgs) -> Result<()> {
     if !(load_kn > 0.0 && args.speed_kmh > 0.0 && args.mu > 0.0) {
         bail!("--load-kn, --speed-kmh and --mu must be positive");
     }
-    let (geo, model, mass) = match &vehicle {
-        Some(v) => (
-            v.contact.geometry.clone(),
-            v.contact.model(),
-            0.5 * v.bodies[v.contact.wheelsets[0]].mass,
-        ),
+    let setup = match &vehicle {
+        Some(v) => Setup {
+            table: v.contact.table().clone(),
+            model: v.contact.model(),
+            mass: 0.5 * v.bodies[v.contact.wheelsets[0]].mass,
+            r0: v.contact.geometry.nominal_radius,
+            load: load_kn * 1e3,
+            flange_angle: v.contact.flange_angle,
+        },
         None => {
             let law = CreepLaw::parse(&args.law)
                 .ok_or_else(|| anyhow::anyhow!("--law must be polach, fastsim or linear"))?;
-            let model = ContactModel {
-                material: Material::STEEL,
-                friction: args.mu,
-                law,
-                damping_ratio: 0.05,
-            };
-            (args.wheelset.geometry()?, model, 600.0)
+            let geo = args.wheelset.geometry()?;
+            Setup {
+                table: geo.table(
+                    railforce::vehicle::ContactSettings::TABLE_RANGE,
+                    railforce::vehicle::ContactSettings::TABLE_STEP,
+                ),
+                model: ContactModel {
+                    material: Material::STEEL,
+                    friction: args.mu,
+                    law,
+                    damping_ratio: 0.05,
+                },
+                mass: 600.0,
+                r0: geo.nominal_radius,
+                load: load_kn * 1e3,
+                flange_angle: 70f64.to_radians(),
+            }
         }
     };
-    let table = match &vehicle {
-        Some(v) => v.contact.table().clone(),
-        None => geo.table(
-            railforce::vehicle::ContactSettings::TABLE_RANGE,
-            railforce::vehicle::ContactSettings::TABLE_STEP,
-        ),
-    };
-    let y = args.y_mm * 1e-3;
-    let yaw = args.yaw_mrad * 1e-3;
-    let rigid = table.lookup(y);
     let speed = args.speed_kmh / 3.6;
     if speed < CREEP_SPEED_FLOOR {
         eprintln!(
             "note: creepages are taken over {CREEP_SPEED_FLOOR} m/s below that speed, as in a run"
         );
     }
+    if args.sweep_y.is_some() || args.sweep_yaw.is_some() {
+        return sweep(&setup, &args);
+    }
+    let y = args.y_mm * 1e-3;
+    let yaw = args.yaw_mrad * 1e-3;
+    let st = solve(&setup, &args, y, yaw);
     println!(
         "wheelset y {:+.2} mm, yaw {:+.2} mrad → rigid roll {:+.4} mrad (+ {:+.3} given), centre height {:.3} mm",
         args.y_mm,
         args.yaw_mrad,
-        rigid.roll * 1e3,
+        st.roll * 1e3,
         args.extra_roll_mrad,
-        rigid.z * 1e3
+        st.height * 1e3
     );
+    match args.spin {
+        Some(s) => println!("spin {s:.4} rad/s (given)"),
+        None => println!(
+            "spin {:.4} rad/s: rolling at the mean rolling radius at this shift, {:.2} mm (--spin to set it)",
+            st.spin,
+            st.rolling_radius * 1e3
+        ),
+    }
     println!(
         "{:<11} {:>8} {:>8} {:>9} {:>8} {:>8} {:>6} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8}",
         "wheel",
@@ -186,27 +335,20 @@ pub fn run(args: ContactArgs) -> Result<()> {
         "{:<11} {:>8} {:>8} {:>9} {:>8} {:>8} {:>6} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8}",
         "", "um", "mm", "mm", "deg", "kN", "mm", "mm", "MPa", "", "", "1/m", "kN", "kN", "kN", "kN"
     );
-    for side in [Side::Left, Side::Right] {
-        let mut w = WheelOnRail::rolling(side, speed, geo.nominal_radius, 0.0, mass);
-        w.y = y;
-        w.yaw = yaw;
-        w.roll = rigid.roll + args.extra_roll_mrad * 1e-3;
-        w.velocity = [
-            speed * yaw.cos() - args.lateral_velocity * yaw.sin(),
-            speed * yaw.sin() + args.lateral_velocity * yaw.cos(),
-            0.0,
-        ];
-        let spin = args.spin.unwrap_or(speed / geo.nominal_radius);
-        w.angular_velocity = [-spin * yaw.sin(), spin * yaw.cos(), args.yaw_rate];
-        w.height = height_for_load(&table, &model, &w, load_kn * 1e3);
-        let f = evaluate(&table, &model, &w);
-        let name = if side == Side::Left { "left" } else { "right" };
+    let limit = nadal(setup.flange_angle, setup.model.friction);
+    for wr in &st.wheels {
+        let f = &wr.forces;
+        let name = if wr.side == Side::Left {
+            "left"
+        } else {
+            "right"
+        };
         for (j, p) in f.patches.iter().enumerate() {
             let Some(p) = p else { continue };
             println!(
                 "{:<11} {:>8.1} {:>8.1} {:>9.2} {:>8.3} {:>8.2} {:>6.2} {:>6.2} {:>7.0} {:>9.2e} {:>9.2e} {:>9.3} {:>8.2} {:>8.2} {:>8.2} {:>8.2}",
                 format!("{name}{}", if j > 0 { " (2nd)" } else { "" }),
-                (rigid.z - w.height) * 1e6,
+                wr.approach * 1e6,
                 (y + p.point[1]) * 1e3,
                 p.radius * 1e3,
                 p.angle.to_degrees(),
@@ -223,12 +365,28 @@ pub fn run(args: ContactArgs) -> Result<()> {
                 p.force[2] * 1e-3
             );
         }
+        let yq = y_over_q(f);
         println!(
-            "{:<11} wheel total Y {:+.2} kN, Q {:.2} kN over {} patch(es)",
+            "{:<11} wheel total Y {:+.2} kN, Q {:.2} kN, |Y|/Q {:.3} over {} patch(es)",
             "",
             f.force[1] * 1e-3,
             f.force[2] * 1e-3,
+            yq,
             f.patches.iter().flatten().count()
+        );
+        if yq > limit {
+            eprintln!(
+                "warning: {name} wheel |Y|/Q {yq:.3} is beyond Nadal's flange-climb limit {limit:.3} (flange angle {:.0}°, μ {}): in a run this wheel would climb its flange",
+                setup.flange_angle.to_degrees(),
+                setup.model.friction
+            );
+        }
+    }
+    if y.abs() > railforce::vehicle::ContactSettings::TABLE_RANGE {
+        eprintln!(
+            "warning: a shift of {:.1} mm lies beyond the contact table (±{:.0} mm): the wheel is off its rail",
+            args.y_mm,
+            railforce::vehicle::ContactSettings::TABLE_RANGE * 1e3
         );
     }
     println!(
@@ -237,11 +395,126 @@ pub fn run(args: ContactArgs) -> Result<()> {
     if args.conicity {
         println!("equivalent conicity (EN 15302 integral method):");
         for amp_mm in [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0] {
-            match table.equivalent_conicity(amp_mm * 1e-3) {
+            match setup.table.equivalent_conicity(amp_mm * 1e-3) {
                 Some(l) => println!("  amplitude {amp_mm:>4.1} mm: {l:.4}"),
                 None => println!("  amplitude {amp_mm:>4.1} mm: no oscillation found"),
             }
         }
+    }
+    Ok(())
+}
+
+/// One row of a sweep.
+#[derive(serde::Serialize)]
+struct SweepRow {
+    y_mm: f64,
+    yaw_mrad: f64,
+    wheel: &'static str,
+    patches: usize,
+    angle_deg: f64,
+    rolling_radius_mm: f64,
+    y_kn: f64,
+    q_kn: f64,
+    y_over_q: f64,
+    fx_kn: f64,
+    approach_um: f64,
+    beyond_nadal: bool,
+}
+
+fn sweep(setup: &Setup, args: &ContactArgs) -> Result<()> {
+    let ys = match &args.sweep_y {
+        Some(r) => range(r, "--sweep-y")?,
+        None => vec![args.y_mm],
+    };
+    let yaws = match &args.sweep_yaw {
+        Some(r) => range(r, "--sweep-yaw")?,
+        None => vec![args.yaw_mrad],
+    };
+    let limit = nadal(setup.flange_angle, setup.model.friction);
+    let range_mm = railforce::vehicle::ContactSettings::TABLE_RANGE * 1e3;
+    if let Some(y) = ys.iter().find(|y| y.abs() > range_mm) {
+        bail!("--sweep-y reaches {y} mm, beyond the contact table's ±{range_mm:.0} mm");
+    }
+    let mut rows = Vec::new();
+    for &yaw in &yaws {
+        for &y in &ys {
+            let st = solve(setup, args, y * 1e-3, yaw * 1e-3);
+            for wr in &st.wheels {
+                let f = &wr.forces;
+                let yq = y_over_q(f);
+                rows.push(SweepRow {
+                    y_mm: y,
+                    yaw_mrad: yaw,
+                    wheel: if wr.side == Side::Left {
+                        "left"
+                    } else {
+                        "right"
+                    },
+                    patches: f.patches.iter().flatten().count(),
+                    angle_deg: f.main().map_or(f.rigid_angle, |p| p.angle).to_degrees(),
+                    rolling_radius_mm: f.main().map_or(f.rigid_radius, |p| p.radius) * 1e3,
+                    y_kn: f.force[1] * 1e-3,
+                    q_kn: f.force[2] * 1e-3,
+                    y_over_q: yq,
+                    fx_kn: f.patches.iter().flatten().map(|p| p.creep.x).sum::<f64>() * 1e-3,
+                    approach_um: wr.approach * 1e6,
+                    beyond_nadal: yq > limit,
+                });
+            }
+        }
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("contact_sweep.csv"));
+    let text = if out.extension().is_some_and(|e| e == "json") {
+        serde_json::to_string_pretty(&serde_json::json!({
+            "nadal_limit": limit,
+            "flange_angle_deg": setup.flange_angle.to_degrees(),
+            "friction": setup.model.friction,
+            "speed_kmh": args.speed_kmh,
+            "load_kn": setup.load * 1e-3,
+            "rows": rows,
+        }))?
+    } else {
+        let mut s = String::from(
+            "y_mm,yaw_mrad,wheel,patches,angle_deg,rolling_radius_mm,y_kn,q_kn,y_over_q,fx_kn,approach_um,beyond_nadal\n",
+        );
+        for r in &rows {
+            s += &format!(
+                "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.5},{:.4},{:.3},{}\n",
+                r.y_mm,
+                r.yaw_mrad,
+                r.wheel,
+                r.patches,
+                r.angle_deg,
+                r.rolling_radius_mm,
+                r.y_kn,
+                r.q_kn,
+                r.y_over_q,
+                r.fx_kn,
+                r.approach_um,
+                r.beyond_nadal
+            );
+        }
+        s
+    };
+    railforce::io::write_atomic(&out, |w| w.write_all(text.as_bytes()))?;
+    let climb = rows.iter().filter(|r| r.beyond_nadal).count();
+    println!(
+        "{} states × 2 wheels written to {}{}",
+        ys.len() * yaws.len(),
+        out.display(),
+        if climb > 0 {
+            format!("; {climb} wheel state(s) beyond Nadal's limit {limit:.3}")
+        } else {
+            String::new()
+        }
+    );
+    if climb > 0 {
+        eprintln!(
+            "warning: {climb} wheel state(s) of the sweep lie beyond Nadal's flange-climb limit {limit:.3}"
+        );
     }
     Ok(())
 }
