@@ -23,14 +23,14 @@ pub enum Error {
         /// Parser message, with line and column where the parser gives them.
         message: String,
     },
-    /// Reading or writing a file failed.
-    #[error("{}: {source}", path.display())]
+    /// Reading or writing a file failed. The message is the path and the OS's reason, once
+    /// (the I/O error is not chained as a source, so error reports do not repeat it).
+    #[error("{}: {}", path.display(), reason(error))]
     Io {
         /// Path involved.
         path: PathBuf,
         /// Underlying error.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// A query or computation went outside what the model supports.
     #[error("{0}")]
@@ -51,8 +51,17 @@ impl Error {
     pub fn io(path: &Path, source: std::io::Error) -> Self {
         Error::Io {
             path: path.to_path_buf(),
-            source,
+            error: source,
         }
+    }
+}
+
+/// The OS's reason in words people use: "no such file or directory", without the error code.
+fn reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file or directory".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => e.to_string(),
     }
 }
 

@@ -556,3 +556,58 @@ fn contact_rolls_sweeps_and_warns() {
     let (ok, _, err) = railforce(&["contact", "--sweep-y", "5:1:1"]);
     assert!(!ok && err.contains("FROM ≤ TO"), "{err}");
 }
+
+/// Every example in every subcommand's `--help` runs, in a fresh folder, in the order a user
+/// would type them (data before training, a model before identifying).
+#[test]
+#[ignore = "runs every --help example (generation, training, a closed loop): release, CI"]
+fn every_help_example_runs() {
+    let dir = std::env::temp_dir().join(format!("railforce-examples-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let exe = env!("CARGO_BIN_EXE_railforce");
+    let mut ran = 0;
+    for cmd in [
+        "init",
+        "track",
+        "contact",
+        "simulate",
+        "generate",
+        "select",
+        "train",
+        "evaluate",
+        "identify",
+        "validate",
+        "experiment",
+    ] {
+        let (ok, help, _) = railforce(&[cmd, "--help"]);
+        assert!(
+            ok && help.contains("Examples:"),
+            "{cmd} --help has no examples"
+        );
+        let examples: Vec<&str> = help
+            .split("Examples:")
+            .nth(1)
+            .unwrap()
+            .lines()
+            .filter_map(|l| l.strip_prefix("  railforce "))
+            .collect();
+        assert!(!examples.is_empty(), "{cmd}");
+        for e in examples {
+            let out = Command::new("sh")
+                .arg("-c")
+                .arg(format!("'{exe}' {e}"))
+                .current_dir(&dir)
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "`railforce {e}` failed:\n{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            ran += 1;
+        }
+    }
+    assert!(ran >= 18, "{ran} examples");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -35,6 +35,9 @@ enum Command {
     /// profile and the irregularity settings. `--out` writes the geometry and both rails'
     /// irregular offsets every `--step` metres as CSV; `--psd` compares the synthesised
     /// irregularities with the FRA PSD formula (RMS table, Welch PSD to CSV).
+    #[command(
+        after_help = "Examples:\n  railforce track curve_r400\n  railforce track tracks/curve_r400.toml --out r400.csv --step 0.5\n  railforce track tracks/tangent.toml --psd"
+    )]
     Track(track::TrackArgs),
     /// Contact of both wheels of a wheelset in a given state: contact points, angles,
     /// ellipses, creepages and forces.
@@ -42,7 +45,12 @@ enum Command {
     /// The same evaluation a simulation step runs (elastic strip contact: one or two patches
     /// per wheel, Hertz ellipse, creepages, creep law), at the wheelset height where each
     /// wheel carries the given load. Forces are those of the rail on the wheel: Fx, Fy in the
-    /// contact plane; Y (+ left) and Q (+ up) in the track frame.
+    /// contact plane; Y (+ left) and Q (+ up) in the track frame. By default the wheelset
+    /// rolls at the mean rolling radius of its two wheels at the shift; `--sweep-y` and
+    /// `--sweep-yaw` write a table of states.
+    #[command(
+        after_help = "Examples:\n  railforce contact --vehicle c80 --y-mm 6 --yaw-mrad 2\n  railforce contact --vehicle c80 --sweep-y -10:10:0.5 --out sweep.csv"
+    )]
     Contact(contact::ContactArgs),
     /// Simulate a vehicle on a track and record the 21 sensor channels, the forces of every
     /// wheel and the motion of every body at 200 Hz.
@@ -51,6 +59,9 @@ enum Command {
     /// diverging run or a derailment (flange climb, or |Y/Q| above Nadal's limit for more
     /// than 50 ms) stops with a message naming the time and the wheel or body; nothing
     /// non-finite is ever written, and the CSV appears only when complete.
+    #[command(
+        after_help = "Examples:\n  railforce simulate --track curve_r400 --speed-kmh 60 --duration 5 --out run.csv\n  railforce simulate --vehicle c80_empty --track tangent --speed-kmh 80 --duration 5 --out empty.csv"
+    )]
     Simulate(simulate::SimulateArgs),
     /// Generate a data set: every condition and seed of a plan, in parallel, one file per run
     /// (npz, parquet or csv) plus manifest.json; resumable, shardable (`--shard i/N`, then `--merge`).
@@ -58,24 +69,39 @@ enum Command {
     /// A rerun skips the runs the manifest lists as done with the same definition and redoes
     /// the rest; files are written atomically. `--snr-db X` adds `<channel>_noisy` copies of
     /// the 21 input channels (white Gaussian noise at X dB, seeded); labels are never noised.
+    /// The plan file's keys (per-condition vehicle, class, seeds, start; [dataset] channel
+    /// subset and float32) are listed in the README, "Plan files".
+    #[command(
+        after_help = "Examples:\n  railforce generate --plan demo --out data/demo --snr-db 6\n  (the paper's 34 conditions, 136 runs: railforce generate --plan paper34 --out data/paper34 --snr-db 6)"
+    )]
     Generate(generate::GenerateArgs),
     /// Feature selection on a data set: mutual information of each of the 21 inputs with the
     /// target (Kraskov k = 3), then forward selection by validation R² of ridge regression on
     /// flattened windows; writes the selected channels and their z-score statistics.
     ///
-    /// The split is leak-free: each run is cut into contiguous 70/15/15 % blocks before
-    /// windowing, and all statistics come from the training blocks.
+    /// The split is leak-free: by seed when the data set has three or more (whole runs on
+    /// other irregularities validate), else contiguous 70/15/15 % blocks of each run; all
+    /// statistics come from the training part.
+    #[command(
+        after_help = "Examples:\n  railforce select --data data/demo --target FQ --out selection_fq.json"
+    )]
     Select(select::SelectArgs),
     /// Train a model (cnn-bilstm, cnn, bilstm, gru, svr, gbdt, xgboost, tree) on a data set.
     ///
-    /// Leak-free windows (70/15/15 % contiguous blocks per run, or whole conditions held out),
-    /// z-scores from the training blocks only. Networks: Adam, MSE, batch 64, early stopping
-    /// on the validation loss (patience 20) with the best weights restored, a checkpoint every
-    /// epoch (`--resume`), train_log.jsonl. Classical models: fitted on up to 40 000 training
-    /// windows. The model directory holds everything `evaluate` and `identify` need.
+    /// Leak-free windows (whole runs by seed, contiguous blocks, or whole conditions held
+    /// out), z-scores from the training part only. Networks: Adam, MSE, batch 64, fresh input
+    /// noise every epoch, early stopping on the validation loss (patience 20) with the best
+    /// weights restored, a checkpoint every epoch (`--resume`), train_log.jsonl. Classical
+    /// models: fitted on up to 40 000 training windows. The model directory holds everything
+    /// `evaluate` and `identify` need.
+    #[command(
+        after_help = "Examples:\n  railforce train --data data/demo --model gru --epochs 3 --out models/demo\n  railforce train --data data/demo --model tree --target w1l,w1r --out models/wheels"
+    )]
     Train(train::TrainArgs),
     /// Score a trained model on a data set: MSE and R² on standardised targets with
-    /// Var(y_test), RMSE and MAE in kN, predictions to CSV.
+    /// Var(y_test), RMSE and MAE in kN, per condition and pooled; predictions and
+    /// per-condition metrics to CSV.
+    #[command(after_help = "Examples:\n  railforce evaluate --model models/demo --data data/demo")]
     Evaluate(train::EvaluateArgs),
     /// Identify wheel–rail forces from a sensor recording with a trained model, with safety
     /// indices (|Y|/Q, wheel unloading ΔQ/Q̄, wheelset lateral force) and an exceedance report.
@@ -83,19 +109,31 @@ enum Command {
     /// The input (CSV, NPZ or Parquet with a `time_s` column) is checked first: every channel
     /// the model needs, 200 Hz without gaps (`--resample` interpolates), no NaN — the error
     /// names the column and row. `--input -` streams CSV lines from standard input and writes
-    /// each estimate as soon as its window is complete.
+    /// each estimate (forces, track position, safety indices) as soon as its window is
+    /// complete, and the exceedance report at the end of the stream.
+    #[command(
+        after_help = "Examples:\n  railforce identify --model models/demo --input data/demo/curve_r400_v60_seed4.npz --out identified.csv\n  railforce identify --model models/wheels --input run.csv --out wheels.csv\n  railforce identify --model models/demo --input - --out streamed.csv < run.csv"
+    )]
     Identify(identify::IdentifyArgs),
     /// Rerun the paper's experiments: model comparison, generalisation over conditions
     /// (with leave-one-condition-out) and robustness to noise, and two of ours: the protocols
     /// side by side and on-board sensor selection. Defaults: split by seed (independent test
     /// runs), 6 dB with σ from each channel's std, centre label. Writes tables (Markdown,
-    /// CSV), SVG figures and index.html with the paper's numbers beside ours.
+    /// CSV), SVG figures and index.html with the paper's numbers beside ours. The full
+    /// protocol on the paper's 34 conditions (`experiment all --plan paper34`) takes about an
+    /// hour on two cores; the README lists what each part measured.
+    #[command(
+        after_help = "Examples:\n  railforce experiment comparison --plan demo --out experiments --epochs 2 --windows-per-epoch 2000"
+    )]
     Experiment(experiment::ExperimentArgs),
     /// The whole chain in a few minutes: simulate three short conditions, train a CNN-BiLSTM
     /// and GBDT, sweep two SNRs, and write the report (demo/index.html).
     Demo(experiment::DemoArgs),
     /// Check railforce against reference solutions and in closed loop (`validate contact`,
     /// `validate dynamics`, `validate identify`).
+    #[command(
+        after_help = "Examples:\n  railforce validate contact\n  railforce validate identify --model models/demo --plan demo"
+    )]
     Validate(validate::ValidateArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
     /// `bench learn`).
@@ -107,6 +145,7 @@ enum Command {
     /// built-in file (e.g. `vehicles/c80.toml`, `tracks/demo.plan.toml`) uses the built-in
     /// copy, so the defaults work from any folder after `cargo install`; files you give always
     /// take precedence.
+    #[command(after_help = "Examples:\n  railforce init my_project")]
     Init(InitArgs),
 }
 

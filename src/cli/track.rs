@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct TrackArgs {
-    /// Track file (TOML), e.g. tracks/r400.toml.
+    /// Track file (TOML), e.g. tracks/curve_r400.toml, or a built-in name: curve_r400.
     file: PathBuf,
     /// Write geometry and rail irregularities to this CSV file.
     #[arg(long, value_name = "CSV")]

@@ -189,6 +189,21 @@ pub fn split(args: &DataArgs, ds: &DataSet) -> Result<Split> {
             if args.test_conditions.is_empty() {
                 bail!("--split conditions needs --test-conditions (and --val-conditions)");
             }
+            let mut known: Vec<&str> = ds.runs.iter().map(|r| r.condition.as_str()).collect();
+            known.sort_unstable();
+            known.dedup();
+            for (flag, list) in [
+                ("--test-conditions", &args.test_conditions),
+                ("--val-conditions", &args.val_conditions),
+            ] {
+                if let Some(c) = list.iter().find(|c| !known.contains(&c.as_str())) {
+                    bail!(
+                        "{flag}: unknown condition {c}; {} has: {}",
+                        ds.dir.display(),
+                        known.join(", ")
+                    );
+                }
+            }
             Split::Conditions {
                 val: args.val_conditions.clone(),
                 test: args.test_conditions.clone(),
