@@ -21,6 +21,36 @@ fn tmp(name: &str) -> std::path::PathBuf {
     dir.join(name)
 }
 
+/// A small noised data set (6 dB, seeds 1–3, one condition) generated through the CLI.
+fn tiny_data(name: &str, track: &str, duration: f64, format: &str) -> std::path::PathBuf {
+    let plan = tmp(&format!("{name}.plan.toml"));
+    let root = env!("CARGO_MANIFEST_DIR");
+    std::fs::write(
+        &plan,
+        format!(
+            "name = \"{name}\"\nvehicle = \"{root}/vehicles/c80.toml\"\nduration_s = {duration}\nseeds = [1, 2, 3]\n\
+             [[condition]]\nname = \"{track}\"\ntrack = \"{root}/tracks/{track}.toml\"\nspeed_kmh = 60.0\n"
+        ),
+    )
+    .unwrap();
+    let data = tmp(&format!("{name}_data"));
+    let (ok, _, err) = railforce(&[
+        "generate",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--out",
+        data.to_str().unwrap(),
+        "--format",
+        format,
+        "--snr-db",
+        "6",
+        "--settle",
+        "0.1",
+    ]);
+    assert!(ok, "{err}");
+    data
+}
+
 #[test]
 fn help_explains_each_subcommand() {
     let (ok, out, _) = railforce(&["--help"]);
@@ -172,29 +202,7 @@ fn learning_commands_explain_bad_input() {
 /// data set lacks are drawn with its noise, and the model records that noise and the split.
 #[test]
 fn select_onboard_then_train_on_noisy_inputs() {
-    let plan = tmp("onboard.plan.toml");
-    let root = env!("CARGO_MANIFEST_DIR");
-    std::fs::write(
-        &plan,
-        format!(
-            "name = \"onboard\"\nvehicle = \"{root}/vehicles/c80.toml\"\nduration_s = 0.4\nseeds = [1, 2, 3]\n\
-             [[condition]]\nname = \"tangent\"\ntrack = \"{root}/tracks/tangent.toml\"\nspeed_kmh = 60.0\n"
-        ),
-    )
-    .unwrap();
-    let data = tmp("onboard_data");
-    let (ok, _, err) = railforce(&[
-        "generate",
-        "--plan",
-        plan.to_str().unwrap(),
-        "--out",
-        data.to_str().unwrap(),
-        "--snr-db",
-        "6",
-        "--settle",
-        "0.1",
-    ]);
-    assert!(ok, "{err}");
+    let data = tiny_data("onboard", "tangent", 0.4, "npz");
     let sel = tmp("onboard_sel.json");
     let (ok, out, err) = railforce(&[
         "select",
@@ -209,6 +217,29 @@ fn select_onboard_then_train_on_noisy_inputs() {
     assert!(ok, "{err}");
     assert!(err.contains("drawing the noisy copies"), "{err}");
     assert!(out.contains("split by seed"), "{out}");
+    // A misspelt condition is named, with the ones the data set has.
+    let (ok, _, err) = railforce(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        "tree",
+        "--test-conditions",
+        "tangnet",
+        "--out",
+        tmp("nowhere").to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("unknown condition tangnet") && err.contains("has: tangent"),
+        "{err}"
+    );
+    // A missing folder: the OS's reason said once, in words.
+    let (ok, _, err) = railforce(&["train", "--data", "/no/such/data", "--out", "x"]);
+    assert!(
+        !ok && err.matches("no such file or directory").count() == 1,
+        "{err}"
+    );
+    assert!(!err.contains("os error"), "{err}");
     let model = tmp("onboard_model");
     let (ok, out_train, err) = railforce(&[
         "train",
@@ -366,31 +397,7 @@ fn demo_runs_from_an_empty_folder() {
 /// track position carried through and ASCII column names.
 #[test]
 fn identify_both_wheels_streaming_equals_batch() {
-    let plan = tmp("wheels.plan.toml");
-    let root = env!("CARGO_MANIFEST_DIR");
-    std::fs::write(
-        &plan,
-        format!(
-            "name = \"wheels\"\nvehicle = \"{root}/vehicles/c80.toml\"\nduration_s = 0.5\nseeds = [1, 2, 3]\n\
-             [[condition]]\nname = \"curve\"\ntrack = \"{root}/tracks/curve_r400.toml\"\nspeed_kmh = 60.0\n"
-        ),
-    )
-    .unwrap();
-    let data = tmp("wheels_data");
-    let (ok, _, err) = railforce(&[
-        "generate",
-        "--plan",
-        plan.to_str().unwrap(),
-        "--out",
-        data.to_str().unwrap(),
-        "--format",
-        "csv",
-        "--snr-db",
-        "6",
-        "--settle",
-        "0.1",
-    ]);
-    assert!(ok, "{err}");
+    let data = tiny_data("wheels", "curve_r400", 0.5, "csv");
     let model = tmp("wheels_model");
     let (ok, _, err) = railforce(&[
         "train",
@@ -421,7 +428,7 @@ fn identify_both_wheels_streaming_equals_batch() {
         !ok && err.contains("unknown target FX") && err.contains("w1l"),
         "{err}"
     );
-    let input = data.join("curve_seed3.csv");
+    let input = data.join("curve_r400_seed3.csv");
     let batch = tmp("wheels_batch.csv");
     let (ok, _, err) = railforce(&[
         "identify",

@@ -106,7 +106,7 @@ mod tests {
             ]
         );
         // float32: values to f32 precision, time kept f64.
-        let t = [0.005, 1e-9 + 0.01];
+        let t = [0.005, 1e-9 + 0.01, 0.015];
         let single = write_parquet(&[("a", &b), ("time_s", &t)], true).unwrap();
         let back = read_parquet(single).unwrap();
         assert_eq!(
