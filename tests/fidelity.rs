@@ -203,7 +203,16 @@ fn run_cli_and_library_compute_the_same_contact() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
         .args(["contact", "--vehicle"])
         .arg(root().join("vehicles/c80.toml"))
-        .args(["--y-mm", "4", "--load-kn", "122.6", "--speed-kmh", "60", "--spin", &spin])
+        .args([
+            "--y-mm",
+            "4",
+            "--load-kn",
+            "122.6",
+            "--speed-kmh",
+            "60",
+            "--spin",
+            &spin,
+        ])
         .output()
         .unwrap();
     assert!(
