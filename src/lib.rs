@@ -3,11 +3,13 @@
 //! Railway vehicle dynamics and wheel–rail force identification: a C80 heavy-haul wagon on
 //! tracks with FRA irregularities, virtual sensors, data sets, and force identification.
 //!
-//! Data flows one way: [`track`] → simulation → sensors → data sets → features → models.
+//! Data flows one way: [`track`] → simulation → sensors → data sets → features → models →
+//! experiments and reports → identification and [`assess`]ment.
 //! Every stage is a module with a small public surface.
 
 #![warn(missing_docs)]
 
+pub mod assess;
 pub mod contact;
 pub mod dataset;
 pub mod dsp;

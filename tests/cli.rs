@@ -615,6 +615,6 @@ fn every_help_example_runs() {
             ran += 1;
         }
     }
-    assert!(ran >= 18, "{ran} examples");
+    assert!(ran >= 20, "{ran} examples");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -13,6 +13,10 @@ use std::sync::OnceLock;
 
 /// The built-in files: path relative to the repository root, and text.
 pub const FILES: &[(&str, &str)] = &[
+    (
+        "vehicles/assessment.toml",
+        railforce::assess::criteria::DEFAULT,
+    ),
     ("vehicles/c80.toml", include_str!("../../vehicles/c80.toml")),
     ("vehicles/c80.urdf", include_str!("../../vehicles/c80.urdf")),
     (

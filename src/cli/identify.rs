@@ -55,6 +55,7 @@ impl LimitArgs {
             unloading: self.limit_unloading,
             static_wheel_load_kn,
             min_duration_s: self.min_duration_ms / 1000.0,
+            ..Limits::default()
         })
     }
 }

@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch. Each subcommand lives in its own file and only turns
 //! arguments into library calls and library results into text.
 
+mod assess;
 mod bench;
 mod builtin;
 mod contact;
@@ -135,6 +136,18 @@ enum Command {
         after_help = "Examples:\n  railforce validate contact\n  railforce validate identify --model models/demo --plan demo"
     )]
     Validate(validate::ValidateArgs),
+    /// Assess a run as acceptance engineers do: forces filtered at 20 Hz, (Y/Q)2m and (ΣY)2m
+    /// as sliding means over 2 m of track with their 99.85 % percentiles, Q's 99.85 %,
+    /// quasi-static Yqst and Qqst over curves, and the Chinese derailment criteria with
+    /// their 50 ms time criterion — per wheel and per section of track, each against a limit
+    /// that cites its source (vehicles/assessment.toml; --criteria for your own).
+    ///
+    /// Works on simulated runs and on identify output alike, so the true and the identified
+    /// forces of a run are judged by the same statistics.
+    #[command(
+        after_help = "Examples:\n  railforce assess run.csv --track curve_r400\n  railforce assess identified.csv --out identified_assessment"
+    )]
+    Assess(assess::AssessArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
     /// `bench learn`).
     Bench(bench::BenchArgs),
@@ -184,6 +197,7 @@ pub fn main() -> ExitCode {
         Command::Experiment(args) => experiment::run(args),
         Command::Demo(args) => experiment::demo(args),
         Command::Validate(args) => validate::run(args),
+        Command::Assess(args) => assess::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Init(args) => init(args),
     };

@@ -1,7 +1,9 @@
 //! Signal processing shared by several stages (spectral estimates, filters).
 
+pub mod butterworth;
 pub mod stats;
 pub mod welch;
 
+pub use butterworth::Butterworth;
 pub use stats::percentile;
 pub use welch::{WelchPsd, welch_psd};

@@ -23,6 +23,13 @@ pub struct Limits {
     /// Shortest excursion above a limit that counts as an exceedance, s.
     #[serde(default = "default_min_duration")]
     pub min_duration_s: f64,
+    /// α of the wheelset lateral force limit `α·(10 + P_st/3)` kN.
+    #[serde(default = "default_lateral_alpha")]
+    pub lateral_alpha: f64,
+}
+
+fn default_lateral_alpha() -> f64 {
+    0.85
 }
 
 fn default_min_duration() -> f64 {
@@ -40,14 +47,16 @@ impl Default for Limits {
             unloading: 0.65,
             static_wheel_load_kn: 25_000.0 * crate::GRAVITY / 2.0 / 1000.0,
             min_duration_s: DEFAULT_MIN_DURATION_S,
+            lateral_alpha: default_lateral_alpha(),
         }
     }
 }
 
 impl Limits {
-    /// Wheelset lateral force limit `0.85·(10 + P_st/3)` kN, `P_st` the static axle load in kN.
+    /// Wheelset lateral force limit `α·(10 + P_st/3)` kN (α = 0.85 by default), `P_st` the
+    /// static axle load in kN.
     pub fn lateral_kn(&self) -> f64 {
-        0.85 * (10.0 + 2.0 * self.static_wheel_load_kn / 3.0)
+        self.lateral_alpha * (10.0 + 2.0 * self.static_wheel_load_kn / 3.0)
     }
 }
 

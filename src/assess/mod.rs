@@ -1,0 +1,444 @@
+//! Assessment of a run as acceptance engineers read it: the forces low-pass filtered, then
+//! EN 14363 / UIC 518-style statistics — (Y/Q)2m and (ΣY)2m as sliding means over 2 m of
+//! track in steps of 0.5 m with their 0.15 % and 99.85 % percentiles, Q's 99.85 %, the
+//! quasi-static Yqst and Qqst as medians over curves — and the Chinese derailment criteria
+//! with their time criterion, per wheel (or wheelset) and per section of track, each against
+//! its limit from the criteria file ([`criteria`]), which cites where every number comes from.
+//!
+//! Works on a simulated run (forces named `w1l_force_y`) and on `identify` output
+//! (`w1l_force_y_N`) alike: the same statistics of true and identified forces.
+
+pub mod criteria;
+pub mod statistics;
+
+use crate::dsp::{Butterworth, percentile};
+use crate::error::{Error, Result};
+use crate::identify::Identified;
+use crate::identify::safety::{Limits, indices};
+use crate::track::{SectionKind, TrackSpec};
+pub use criteria::Criteria;
+use serde::Serialize;
+use statistics::sliding_mean;
+
+/// Y and Q of one wheel over a run, N.
+#[derive(Debug, Clone)]
+pub struct WheelSeries {
+    /// Wheel name (`w1l`).
+    pub wheel: String,
+    /// Lateral force Y.
+    pub y: Vec<f64>,
+    /// Vertical force Q.
+    pub q: Vec<f64>,
+}
+
+/// The forces of a run with time and track position.
+#[derive(Debug, Clone)]
+pub struct RunForces {
+    /// Time, s.
+    pub time: Vec<f64>,
+    /// Track position of the vehicle, m.
+    pub s: Vec<f64>,
+    /// Every wheel with both forces, in column order.
+    pub wheels: Vec<WheelSeries>,
+}
+
+impl RunForces {
+    /// From named columns: `time_s`, `s_m` and `w{n}{l|r}_force_{y|z}` (a trailing `_N`, as
+    /// `identify` writes, is accepted). Errors name `source` and what is missing.
+    pub fn from_columns(source: &str, cols: &[(String, Vec<f64>)]) -> Result<Self> {
+        let find = |name: &str| {
+            cols.iter()
+                .find(|(n, _)| n == name || n.strip_suffix("_N") == Some(name))
+                .map(|(_, v)| v.clone())
+        };
+        let time =
+            find("time_s").ok_or_else(|| Error::Domain(format!("{source}: no time_s column")))?;
+        let s = find("s_m").ok_or_else(|| {
+            Error::Domain(format!(
+                "{source}: no s_m column: the sliding means are over track distance (simulate, generate and identify write s_m)"
+            ))
+        })?;
+        let mut wheels = Vec::new();
+        for (name, _) in cols {
+            let base = name.strip_suffix("_N").unwrap_or(name);
+            let Some(wheel) = base.strip_suffix("_force_y") else {
+                continue;
+            };
+            if let (Some(y), Some(q)) = (find(base), find(&format!("{wheel}_force_z"))) {
+                wheels.push(WheelSeries {
+                    wheel: wheel.to_string(),
+                    y,
+                    q,
+                });
+            }
+        }
+        if wheels.is_empty() {
+            return Err(Error::Domain(format!(
+                "{source}: no wheel with both forces (columns w1l_force_y and w1l_force_z, or with _N)"
+            )));
+        }
+        for (what, v) in std::iter::once(("time_s", &time))
+            .chain(std::iter::once(("s_m", &s)))
+            .chain(
+                wheels
+                    .iter()
+                    .flat_map(|w| [("force", &w.y), ("force", &w.q)]),
+            )
+        {
+            if let Some(r) = v.iter().position(|x| !x.is_finite()) {
+                return Err(Error::Domain(format!(
+                    "{source}: {what} column, row {}: not a finite number",
+                    r + 1
+                )));
+            }
+        }
+        Ok(RunForces { time, s, wheels })
+    }
+}
+
+/// A stretch of track assessed on its own.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Span {
+    /// Name (`tangent`, `curve R 400 m`, `transition`, `whole run`).
+    pub name: String,
+    /// Radius of a curve, m.
+    pub radius_m: Option<f64>,
+    /// From, m.
+    pub from_m: f64,
+    /// To, m.
+    pub to_m: f64,
+}
+
+/// The sections of a track, in order.
+pub fn spans(track: &TrackSpec) -> Vec<Span> {
+    track
+        .sections
+        .iter()
+        .map(|sec| {
+            let (name, radius_m) = match sec.kind {
+                SectionKind::Tangent => ("tangent".to_string(), None),
+                SectionKind::Transition => ("transition".to_string(), None),
+                SectionKind::Curve { radius, .. } => {
+                    (format!("curve R {radius:.0} m"), Some(radius))
+                }
+            };
+            Span {
+                name: format!("{name} ({:.0}–{:.0} m)", sec.start, sec.end()),
+                radius_m,
+                from_m: sec.start,
+                to_m: sec.end(),
+            }
+        })
+        .collect()
+}
+
+/// One assessed quantity.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Row {
+    /// Section of track.
+    pub section: String,
+    /// Quantity (`(Y/Q)2m`, `(ΣY)2m`, `Q`, `Yqst`, `Qqst`, `Y/Q (50 ms)`, `ΔQ/Q̄`, `H`).
+    pub quantity: String,
+    /// Wheel or wheelset.
+    pub place: String,
+    /// Statistic compared with the limit (described in `statistic`).
+    pub value: f64,
+    /// Limit.
+    pub limit: f64,
+    /// Unit of value and limit (`-` for ratios).
+    pub unit: String,
+    /// How the value is computed.
+    pub statistic: String,
+    /// Within the limit.
+    pub pass: bool,
+    /// Criteria table the limit comes from (its `source` cites it).
+    pub criterion: String,
+}
+
+/// The assessment of a run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Assessment {
+    /// Static wheel load Q0, kN.
+    pub static_wheel_load_kn: f64,
+    /// Criteria used (with their sources).
+    pub criteria: Criteria,
+    /// Every quantity per section and place.
+    pub rows: Vec<Row>,
+}
+
+/// Samples per second of a time column (median step).
+fn rate(time: &[f64]) -> f64 {
+    let steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    1.0 / percentile(&steps, 50.0)
+}
+
+/// Assesses `run` over `spans` (empty: the whole run as one) against `criteria`, with static
+/// wheel load `q0_kn`.
+pub fn assess(
+    run: &RunForces,
+    spans: &[Span],
+    criteria: &Criteria,
+    q0_kn: f64,
+) -> Result<Assessment> {
+    let fs = rate(&run.time);
+    if !(fs.is_finite() && fs > 2.0 * criteria.filter.lowpass_hz) {
+        return Err(Error::Domain(format!(
+            "sampling rate {fs:.1} Hz is too low for the {} Hz filter",
+            criteria.filter.lowpass_hz
+        )));
+    }
+    let lp = Butterworth::lowpass(criteria.filter.order, criteria.filter.lowpass_hz, fs);
+    let wheels: Vec<WheelSeries> = run
+        .wheels
+        .iter()
+        .map(|w| WheelSeries {
+            wheel: w.wheel.clone(),
+            y: lp.filtfilt(&w.y),
+            q: lp.filtfilt(&w.q),
+        })
+        .collect();
+    let whole = [Span {
+        name: "whole run".into(),
+        radius_m: None,
+        from_m: f64::NEG_INFINITY,
+        to_m: f64::INFINITY,
+    }];
+    let spans = if spans.is_empty() { &whole[..] } else { spans };
+    let c = criteria;
+    let pct = &c.percentiles;
+    let (win, step) = (c.sliding_mean.window_m, c.sliding_mean.step_m);
+    let mut rows = Vec::new();
+    for span in spans {
+        let idx: Vec<usize> = (0..run.s.len())
+            .filter(|&i| run.s[i] >= span.from_m && run.s[i] < span.to_m)
+            .collect();
+        // A section assessed needs at least one full sliding window.
+        let covered = idx.last().map_or(0.0, |&l| run.s[l] - run.s[idx[0]]);
+        if idx.len() < 2 || covered < win {
+            continue;
+        }
+        let pick = |v: &[f64]| -> Vec<f64> { idx.iter().map(|&i| v[i]).collect() };
+        let s = pick(&run.s);
+        let mut push = |quantity: &str,
+                        place: &str,
+                        value: f64,
+                        limit: f64,
+                        unit: &str,
+                        statistic: String,
+                        criterion: &str| {
+            rows.push(Row {
+                section: span.name.clone(),
+                quantity: quantity.into(),
+                place: place.into(),
+                value,
+                limit,
+                unit: unit.into(),
+                statistic,
+                pass: value <= limit,
+                criterion: criterion.into(),
+            });
+        };
+        // Both ends of the sliding means' distribution: the larger in magnitude is assessed.
+        let two_sided = |x: &[f64]| -> f64 {
+            let m: Vec<f64> = sliding_mean(&s, x, win, step)
+                .into_iter()
+                .map(|p| p.1)
+                .collect();
+            percentile(&m, pct.low)
+                .abs()
+                .max(percentile(&m, pct.high).abs())
+        };
+        let sliding_words = format!(
+            "max(|F1|, |F2|) of the {win} m sliding mean every {step} m, F1 = {} %, F2 = {} %",
+            pct.low, pct.high
+        );
+        for w in &wheels {
+            let (y, q) = (pick(&w.y), pick(&w.q));
+            let yq: Vec<f64> = y.iter().zip(&q).map(|(a, b)| a / b.max(1.0)).collect();
+            push(
+                "(Y/Q)2m",
+                &w.wheel,
+                two_sided(&yq),
+                c.y_over_q.limit,
+                "-",
+                sliding_words.clone(),
+                "y_over_q",
+            );
+            push(
+                "Q",
+                &w.wheel,
+                percentile(&q, pct.high) / 1000.0,
+                q0_kn + c.vertical.q_max_over_static_kn,
+                "kN",
+                format!(
+                    "F2 = {} % of the filtered force; limit Q0 + {} kN",
+                    pct.high, c.vertical.q_max_over_static_kn
+                ),
+                "vertical",
+            );
+            if span.radius_m.is_some() {
+                let f0 = pct.quasi_static;
+                push(
+                    "Yqst",
+                    &w.wheel,
+                    percentile(&y, f0).abs() / 1000.0,
+                    c.lateral_quasi_static.y_qst_kn,
+                    "kN",
+                    format!("|F0 = {f0} %| of the filtered force over the curve"),
+                    "lateral_quasi_static",
+                );
+                push(
+                    "Qqst",
+                    &w.wheel,
+                    percentile(&q, f0) / 1000.0,
+                    c.vertical.q_qst_kn,
+                    "kN",
+                    format!("F0 = {f0} % of the filtered force over the curve"),
+                    "vertical",
+                );
+            }
+        }
+        for axle in 1..=wheels.len() {
+            let find = |side: char| wheels.iter().find(|w| w.wheel == format!("w{axle}{side}"));
+            if let (Some(l), Some(r)) = (find('l'), find('r')) {
+                let sum: Vec<f64> = pick(&l.y)
+                    .iter()
+                    .zip(pick(&r.y))
+                    .map(|(a, b)| (a + b) / 1000.0)
+                    .collect();
+                push(
+                    "(ΣY)2m",
+                    &format!("wheelset {axle}"),
+                    two_sided(&sum),
+                    c.track_shift.alpha * (10.0 + 2.0 * q0_kn / 3.0),
+                    "kN",
+                    format!(
+                        "{sliding_words}; limit α·(10 + 2·Q0/3), α = {}",
+                        c.track_shift.alpha
+                    ),
+                    "track_shift",
+                );
+            }
+        }
+        // The Chinese criteria with their time criterion, through the one safety monitor.
+        let id = Identified {
+            targets: wheels
+                .iter()
+                .flat_map(|w| {
+                    [
+                        format!("{}_force_y", w.wheel),
+                        format!("{}_force_z", w.wheel),
+                    ]
+                })
+                .collect(),
+            time: pick(&run.time),
+            values: idx
+                .iter()
+                .map(|&i| wheels.iter().flat_map(|w| [w.y[i], w.q[i]]).collect())
+                .collect(),
+        };
+        let limits = Limits {
+            y_over_q: c.chinese.derailment,
+            unloading: c.chinese.unloading,
+            static_wheel_load_kn: q0_kn,
+            min_duration_s: c.chinese.min_duration_s,
+            lateral_alpha: c.chinese.lateral_alpha,
+        };
+        for r in indices(&id, &limits) {
+            let quantity = match r.index.as_str() {
+                "Y/Q" => "Y/Q (time criterion)".to_string(),
+                "H (kN)" => "H".to_string(),
+                other => other.to_string(),
+            };
+            rows.push(Row {
+                section: span.name.clone(),
+                quantity,
+                place: r.place.clone(),
+                value: r.max,
+                limit: r.limit,
+                unit: if r.index == "H (kN)" { "kN" } else { "-" }.into(),
+                statistic: format!(
+                    "largest filtered value; fails only above the limit for ≥ {:.0} ms ({} exceedance(s), {} shorter)",
+                    c.chinese.min_duration_s * 1000.0,
+                    r.exceedances.len(),
+                    r.brief_excursions
+                ),
+                pass: r.exceedances.is_empty(),
+                criterion: "chinese".into(),
+            });
+        }
+    }
+    if rows.is_empty() {
+        return Err(Error::Domain(format!(
+            "no section holds {win} m of the run: nothing to assess"
+        )));
+    }
+    Ok(Assessment {
+        static_wheel_load_kn: q0_kn,
+        criteria: criteria.clone(),
+        rows,
+    })
+}
+
+impl Assessment {
+    /// Rows outside their limit.
+    pub fn failures(&self) -> impl Iterator<Item = &Row> {
+        self.rows.iter().filter(|r| !r.pass)
+    }
+
+    /// The table (section, quantity, place, value, limit, unit, verdict, criterion).
+    pub fn table(&self) -> crate::report::table::Table {
+        let mut t = crate::report::table::Table::new(&[
+            "section",
+            "quantity",
+            "place",
+            "value",
+            "limit",
+            "unit",
+            "verdict",
+            "criterion",
+        ]);
+        for r in &self.rows {
+            t.push(vec![
+                r.section.clone(),
+                r.quantity.clone(),
+                r.place.clone(),
+                format!("{:.4}", r.value),
+                format!("{:.4}", r.limit),
+                r.unit.clone(),
+                if r.pass { "pass" } else { "FAIL" }.into(),
+                r.criterion.clone(),
+            ]);
+        }
+        t
+    }
+
+    /// Markdown: the table, then each criterion's source.
+    pub fn markdown(&self) -> String {
+        let c = &self.criteria;
+        let mut s = format!(
+            "# Assessment ({})\n\nStatic wheel load Q0 = {:.1} kN. Forces low-pass filtered at {} Hz (Butterworth order {}, zero phase). {} of {} quantities within their limits.\n\n",
+            c.name,
+            self.static_wheel_load_kn,
+            c.filter.lowpass_hz,
+            c.filter.order,
+            self.rows.iter().filter(|r| r.pass).count(),
+            self.rows.len()
+        );
+        s += &self.table().markdown();
+        s += "\n## Sources\n\n";
+        for (k, src) in [
+            ("filter", &c.filter.source),
+            ("sliding_mean", &c.sliding_mean.source),
+            ("percentiles", &c.percentiles.source),
+            ("y_over_q", &c.y_over_q.source),
+            ("track_shift", &c.track_shift.source),
+            ("vertical", &c.vertical.source),
+            ("lateral_quasi_static", &c.lateral_quasi_static.source),
+            ("chinese", &c.chinese.source),
+        ] {
+            s += &format!("- `{k}`: {src}\n");
+        }
+        s
+    }
+}

@@ -1,0 +1,121 @@
+//! `railforce assess`: a thin shell over `assess`.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use railforce::assess::{Criteria, RunForces, assess, spans};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Args)]
+pub struct AssessArgs {
+    /// Run file: a `simulate` CSV, a `generate` run (npz, parquet, csv) or `identify` output
+    /// (identified forces `w1l_force_y_N` with `s_m`).
+    file: PathBuf,
+    /// Track of the run, to assess each section (tangent, transition, curve by radius) apart
+    /// [default: the track the data set's manifest names for this run, else the whole run as
+    /// one section].
+    #[arg(long)]
+    track: Option<PathBuf>,
+    /// Criteria file (filters, windows, percentiles, limits, each with its source) [default:
+    /// the built-in vehicles/assessment.toml].
+    #[arg(long)]
+    criteria: Option<PathBuf>,
+    /// Static wheel load Q0, kN [default: the --vehicle's weight over its wheels].
+    #[arg(long)]
+    static_wheel_load_kn: Option<f64>,
+    /// Vehicle whose weight gives Q0.
+    #[arg(long, default_value = "vehicles/c80.toml")]
+    vehicle: PathBuf,
+    /// Output folder for assessment.md, .csv and .json [default: FILE's name + _assessment].
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// The track a data set's manifest records for the run file `file`, if any.
+fn track_from_manifest(file: &Path) -> Option<PathBuf> {
+    let dir = file.parent()?;
+    let text = std::fs::read_to_string(dir.join("manifest.json")).ok()?;
+    let m: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let name = file.file_name()?.to_str()?;
+    let run = m["runs"].as_array()?.iter().find(|r| r["file"] == name)?;
+    let p = PathBuf::from(run["track"]["file"].as_str()?);
+    p.exists().then_some(p)
+}
+
+pub fn run(args: AssessArgs) -> Result<()> {
+    let criteria = match &args.criteria {
+        Some(p) => Criteria::load(&super::builtin::resolve(p)?)?,
+        None => Criteria::builtin(),
+    };
+    let q0 = match args.static_wheel_load_kn {
+        Some(q) if q.is_finite() && q > 0.0 => q,
+        Some(q) => anyhow::bail!("--static-wheel-load-kn must be positive, got {q}"),
+        None => {
+            let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&args.vehicle)?)?;
+            v.mass() * railforce::GRAVITY / (2 * v.contact.wheelsets.len()) as f64 * 1e-3
+        }
+    };
+    let cols = railforce::features::read_table(&args.file)?;
+    let run = RunForces::from_columns(&args.file.display().to_string(), &cols)?;
+    let track = match &args.track {
+        Some(t) => Some(super::builtin::resolve(t)?),
+        None => track_from_manifest(&args.file),
+    };
+    let sections = match &track {
+        Some(t) => {
+            let spec = railforce::track::TrackSpec::load(t)?;
+            eprintln!("sections from {}", t.display());
+            spans(&spec)
+        }
+        None => {
+            eprintln!("no track given (--track): the whole run is one section");
+            Vec::new()
+        }
+    };
+    let a = assess(&run, &sections, &criteria, q0)?;
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = args
+            .file
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        args.file.with_file_name(format!("{stem}_assessment"))
+    });
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let md = a.markdown();
+    railforce::io::write_atomic(&out.join("assessment.md"), |w| w.write_all(md.as_bytes()))?;
+    let csv = a.table().csv();
+    railforce::io::write_atomic(&out.join("assessment.csv"), |w| w.write_all(csv.as_bytes()))?;
+    let json = serde_json::to_string_pretty(&a)?;
+    railforce::io::write_atomic(&out.join("assessment.json"), |w| {
+        w.write_all(json.as_bytes())
+    })?;
+    println!(
+        "{:<34} {:<22} {:<11} {:>10} {:>10} {:<4} verdict",
+        "section", "quantity", "place", "value", "limit", "unit"
+    );
+    for r in &a.rows {
+        println!(
+            "{:<34} {:<22} {:<11} {:>10.3} {:>10.3} {:<4} {}",
+            r.section,
+            r.quantity,
+            r.place,
+            r.value,
+            r.limit,
+            r.unit,
+            if r.pass { "pass" } else { "FAIL" }
+        );
+    }
+    let fails = a.failures().count();
+    println!(
+        "{} of {} quantities within their limits{}; Q0 {q0:.1} kN; tables in {} (sources of every limit in assessment.md)",
+        a.rows.len() - fails,
+        a.rows.len(),
+        if fails > 0 {
+            format!(", {fails} FAIL")
+        } else {
+            String::new()
+        },
+        out.display()
+    );
+    Ok(())
+}

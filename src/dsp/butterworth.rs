@@ -1,0 +1,158 @@
+//! Butterworth low-pass filters of any even order as cascaded biquads (bilinear transform with
+//! pre-warping): the simulator's anti-alias filter and the assessment's 20 Hz filter are both
+//! this one design.
+
+/// One second-order section (transposed direct form II).
+#[derive(Debug, Clone, Copy)]
+struct Biquad {
+    b: [f64; 3],
+    a: [f64; 2],
+}
+
+/// Coefficients of a Butterworth low-pass of even order.
+#[derive(Debug, Clone)]
+pub struct Butterworth {
+    sections: Vec<Biquad>,
+    /// Pre-warped cut-off `tan(π·fc/fs)`.
+    k: f64,
+    fs: f64,
+}
+
+impl Butterworth {
+    /// Low-pass of even `order` (≥ 2) with cut-off `fc` (Hz) at sampling rate `fs` (Hz).
+    ///
+    /// # Panics
+    /// When `order` is odd or zero, or `fc` is not inside (0, fs/2).
+    pub fn lowpass(order: usize, fc: f64, fs: f64) -> Self {
+        use std::f64::consts::PI;
+        assert!(order >= 2 && order % 2 == 0, "even order ≥ 2, got {order}");
+        assert!(
+            fc > 0.0 && fc < fs / 2.0,
+            "cut-off {fc} Hz outside (0, {}) Hz",
+            fs / 2.0
+        );
+        let k = (PI * fc / fs).tan();
+        // Butterworth pole pairs of order n: Q = 1/(2 sin θ), θ = (2i + 1)π/(2n).
+        let sections = (0..order / 2)
+            .map(|i| {
+                let q = 1.0 / (2.0 * ((2 * i + 1) as f64 * PI / (2 * order) as f64).sin());
+                let norm = 1.0 / (1.0 + k / q + k * k);
+                let b0 = k * k * norm;
+                Biquad {
+                    b: [b0, 2.0 * b0, b0],
+                    a: [2.0 * (k * k - 1.0) * norm, (1.0 - k / q + k * k) * norm],
+                }
+            })
+            .collect();
+        Butterworth { sections, k, fs }
+    }
+
+    /// Order of the filter.
+    pub fn order(&self) -> usize {
+        2 * self.sections.len()
+    }
+
+    /// Gain at frequency `f` (Hz): `1/√(1 + (tan(πf/fs)/tan(πfc/fs))^{2n})`, the Butterworth
+    /// magnitude through the bilinear transform.
+    pub fn gain(&self, f: f64) -> f64 {
+        let w = (std::f64::consts::PI * f / self.fs).tan() / self.k;
+        1.0 / (1.0 + w.powi(2 * self.order() as i32)).sqrt()
+    }
+
+    /// Filters one sample; `state` holds two values per section ([`Self::order`] in all).
+    #[inline]
+    pub fn step(&self, x: f64, state: &mut [f64]) -> f64 {
+        let mut v = x;
+        for (sec, st) in self.sections.iter().zip(state.chunks_exact_mut(2)) {
+            let y = sec.b[0] * v + st[0];
+            st[0] = sec.b[1] * v - sec.a[0] * y + st[1];
+            st[1] = sec.b[2] * v - sec.a[1] * y;
+            v = y;
+        }
+        v
+    }
+
+    /// The state of a filter that has seen the value `x` for ever (no start transient).
+    pub fn steady_state(&self, x: f64, state: &mut [f64]) {
+        let mut v = x;
+        for (sec, s) in self.sections.iter().zip(state.chunks_exact_mut(2)) {
+            // DC gain of each section is 1: y = v; solve the state for constant input.
+            let y = v;
+            s[1] = sec.b[2] * v - sec.a[1] * y;
+            s[0] = sec.b[1] * v - sec.a[0] * y + s[1];
+            v = y;
+        }
+    }
+
+    /// Zero-phase filtering of a whole record: forward, then backward, each pass started in
+    /// the steady state of its first value (no start transient). The gain is [`Self::gain`]
+    /// squared and the phase zero, so peaks stay where they were.
+    pub fn filtfilt(&self, x: &[f64]) -> Vec<f64> {
+        let mut state = vec![0.0; self.order()];
+        let pass = |input: &mut dyn Iterator<Item = f64>, first: f64, state: &mut [f64]| {
+            self.steady_state(first, state);
+            input.map(|v| self.step(v, state)).collect::<Vec<f64>>()
+        };
+        let Some(&first) = x.first() else {
+            return Vec::new();
+        };
+        let forward = pass(&mut x.iter().copied(), first, &mut state);
+        let last = *forward.last().expect("non-empty");
+        let mut back = pass(&mut forward.iter().rev().copied(), last, &mut state);
+        back.reverse();
+        back
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Peak of the filtered steady sine at `f`.
+    fn response(lp: &Butterworth, f: f64, zero_phase: bool) -> f64 {
+        let fs = lp.fs;
+        let x: Vec<f64> = (0..40_000)
+            .map(|i| (2.0 * std::f64::consts::PI * f * i as f64 / fs).sin())
+            .collect();
+        let y = if zero_phase {
+            lp.filtfilt(&x)
+        } else {
+            let mut st = vec![0.0; lp.order()];
+            x.iter().map(|&v| lp.step(v, &mut st)).collect()
+        };
+        y[15_000..25_000].iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    #[test]
+    fn passes_low_and_stops_high_frequencies() {
+        let lp = Butterworth::lowpass(8, 60.0, 10_000.0);
+        assert!((response(&lp, 5.0, false) - 1.0).abs() < 0.01);
+        assert!((response(&lp, 60.0, false) - std::f64::consts::FRAC_1_SQRT_2).abs() < 0.02);
+        assert!(response(&lp, 500.0, false) < 1e-6);
+        for f in [5.0, 60.0, 100.0] {
+            assert!(
+                (response(&lp, f, false) - lp.gain(f)).abs() < 0.01,
+                "{f} Hz"
+            );
+        }
+        let mut st = vec![0.0; 8];
+        lp.steady_state(3.0, &mut st);
+        assert!((lp.step(3.0, &mut st) - 3.0).abs() < 1e-12);
+    }
+
+    /// The assessment's 20 Hz filter (4th order, forward and backward at 200 Hz): its
+    /// attenuation at 10 and 40 Hz is the closed form squared.
+    #[test]
+    fn zero_phase_20_hz_attenuation() {
+        let lp = Butterworth::lowpass(4, 20.0, 200.0);
+        for f in [10.0, 40.0] {
+            let w = (std::f64::consts::PI * f / 200.0).tan() / (std::f64::consts::PI * 0.1).tan();
+            let expect = 1.0 / (1.0 + w.powi(8));
+            let got = response(&lp, f, true);
+            assert!((got - expect).abs() < 2e-3, "{f} Hz: {got} vs {expect}");
+        }
+        // 10 Hz passes nearly whole (−0.03 dB), 40 Hz is down by about 40 dB.
+        assert!(20.0 * response(&lp, 10.0, true).log10() > -0.1);
+        assert!(20.0 * response(&lp, 40.0, true).log10() < -38.0);
+    }
+}
