@@ -584,6 +584,7 @@ fn every_help_example_runs() {
         "train",
         "evaluate",
         "identify",
+        "assess",
         "validate",
         "experiment",
     ] {
