@@ -298,6 +298,19 @@ fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
     assert_eq!(first["index"], "Y/Q");
     assert_eq!(first["place"], "w1l");
     assert!(first["true_p99_85"].is_number() && first["verdicts_agree"].is_boolean());
+    // The acceptance statistics of the identified forces against the true ones.
+    let stat = &json["runs"][0]["assessment"][0];
+    assert!(
+        stat["true_value"].is_number() && stat["identified_value"].is_number(),
+        "{stat}"
+    );
+    assert!(
+        json["runs"][0]["assessment"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|s| s["quantity"] == "(Y/Q)2m")
+    );
     let traces = std::fs::read_to_string(report.join("traces.csv")).unwrap();
     assert!(traces.starts_with(
         "condition,seed,time_s,w1l_force_y_true_n,w1l_force_y_identified_n,w1l_force_z_true_n"

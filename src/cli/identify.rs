@@ -400,6 +400,31 @@ pub fn validate(
     for w in &under {
         eprintln!("{w}");
     }
+    // The acceptance statistics, true against identified.
+    let stats: Vec<&railforce::assess::StatCheck> =
+        runs.iter().flat_map(|r| &r.assessment).collect();
+    let stat_differ = stats.iter().filter(|c| !c.verdicts_agree).count();
+    for q in ["(Y/Q)2m", "Q", "Yqst", "Qqst"] {
+        let ratios: Vec<f64> = stats
+            .iter()
+            .filter(|c| c.quantity == q)
+            .filter_map(|c| c.ratio)
+            .collect();
+        if !ratios.is_empty() {
+            println!(
+                "assessment {q:<8} identified ÷ true over {} section(s): median {:.3}, range {:.3}–{:.3}",
+                ratios.len(),
+                railforce::dsp::percentile(&ratios, 50.0),
+                railforce::dsp::percentile(&ratios, 0.0),
+                railforce::dsp::percentile(&ratios, 100.0)
+            );
+        }
+    }
+    println!(
+        "assessment verdicts (within the limit or not) agree on {} of {} statistics",
+        stats.len() - stat_differ,
+        stats.len()
+    );
     let checks: usize = runs.iter().map(|r| r.safety.len()).sum();
     let verdicts = if reached == 0 {
         "no limit was reached by the truth or the identification, so the verdicts test nothing here"

@@ -137,6 +137,34 @@ fn section(runs: &[RunCheck], s: &CheckSettings) -> Section {
             ]);
         }
     }
+    let mut stats = Table::new(&[
+        "condition",
+        "section",
+        "quantity",
+        "place",
+        "true",
+        "identified",
+        "identified ÷ true",
+        "limit",
+        "unit",
+        "verdicts agree",
+    ]);
+    for r in runs {
+        for c in &r.assessment {
+            stats.push(vec![
+                r.condition.clone(),
+                c.section.clone(),
+                c.quantity.clone(),
+                c.place.clone(),
+                f(c.true_value),
+                f(c.identified_value),
+                opt(c.ratio),
+                format!("{:.3}", c.limit),
+                c.unit.clone(),
+                if c.verdicts_agree { "yes" } else { "NO" }.into(),
+            ]);
+        }
+    }
     let conditions: Vec<String> = runs.iter().map(|r| r.condition.clone()).collect();
     // One bar series per index and place: identified / true 99.85 % percentile per condition.
     let mut keys: Vec<(String, String)> = Vec::new();
@@ -225,6 +253,11 @@ fn section(runs: &[RunCheck], s: &CheckSettings) -> Section {
                 "Safety indices per condition and wheel".into(),
                 safety,
                 "safety".into(),
+            ),
+            (
+                "Acceptance statistics (railforce assess: 20 Hz, 2 m sliding means, 99.85 %, quasi-static medians over curves) of the identified forces against the true ones, per section".into(),
+                stats,
+                "assessment".into(),
             ),
         ],
         figures,

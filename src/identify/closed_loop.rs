@@ -69,6 +69,9 @@ pub struct RunCheck {
     pub targets: Vec<TargetCheck>,
     /// Per safety index and wheel.
     pub safety: Vec<IndexCheck>,
+    /// The acceptance statistics (`railforce assess`) of the identified forces against the
+    /// true ones, per section of the condition's track.
+    pub assessment: Vec<crate::assess::StatCheck>,
     /// The simulator's forces at the label times.
     #[serde(skip)]
     pub truth: Identified,
@@ -215,11 +218,35 @@ pub fn validate(
             })
             .collect();
         let safety = compare_indices(&truth, &id, limits, margin);
+        // Acceptance statistics over the track's sections, true against identified.
+        let s_col = ds.channel("s_m")?;
+        let s: Vec<f64> = (0..id.time.len())
+            .map(|k| run.columns[s_col][k + off])
+            .collect();
+        let spans = plan
+            .conditions
+            .iter()
+            .find(|c| c.name == run.condition)
+            .map(|c| crate::track::TrackSpec::load(&c.track).map(|t| crate::assess::spans(&t)))
+            .transpose()?
+            .unwrap_or_default();
+        let criteria = crate::assess::Criteria::builtin();
+        let q0 = limits.static_wheel_load_kn;
+        let judge = |f: &Identified| {
+            crate::assess::RunForces::from_identified(f, s.clone())
+                .and_then(|r| crate::assess::assess(&r, &spans, &criteria, q0))
+        };
+        let assessment = match (judge(&truth), judge(&id)) {
+            (Ok(a), Ok(b)) => crate::assess::compare(&a, &b),
+            // Too short a run for a 2 m window, or no wheel with both forces: nothing to compare.
+            _ => Vec::new(),
+        };
         out.push(RunCheck {
             condition: run.condition.clone(),
             seed: run.seed,
             targets,
             safety,
+            assessment,
             truth,
             identified: id,
         });
