@@ -17,6 +17,7 @@ fn run(len: f64, y: impl Fn(f64, usize) -> f64, q: impl Fn(f64, usize) -> f64) -
         time: time.clone(),
         s: s.clone(),
         wheels: vec![wheel("w1l", 1.0), wheel("w1r", -1.0)],
+        carbody: None,
     }
 }
 
@@ -192,4 +193,8 @@ fn a_slow_run_on_smooth_track_passes() {
     );
     let (q, _) = value(&a, "whole run", "Q", "w1l");
     assert!((q - 122.6).abs() < 5.0, "static wheel load: {q} kN");
+    assert!(
+        r.carbody.is_some(),
+        "the run records the carbody accelerations"
+    );
 }

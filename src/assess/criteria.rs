@@ -105,6 +105,20 @@ pub struct Chinese {
     pub source: String,
 }
 
+/// Ride index.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ride {
+    /// Sperling Wz limit (vertical and lateral).
+    pub wz_limit: f64,
+    /// Spectral band of the index, Hz.
+    pub band_hz: [f64; 2],
+    /// Shortest record assessed, s.
+    pub min_seconds: f64,
+    /// Where it comes from.
+    pub source: String,
+}
+
 /// Every criterion of an assessment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -127,6 +141,8 @@ pub struct Criteria {
     pub lateral_quasi_static: LateralQuasiStatic,
     /// |Y|/Q, ΔQ/Q̄, H with a time criterion.
     pub chinese: Chinese,
+    /// Ride index from the carbody accelerations (absent: not assessed).
+    pub ride: Option<Ride>,
 }
 
 impl Criteria {
@@ -205,6 +221,17 @@ impl Criteria {
         positive("chinese.derailment", c.chinese.derailment)?;
         positive("chinese.unloading", c.chinese.unloading)?;
         positive("chinese.lateral_alpha", c.chinese.lateral_alpha)?;
+        if let Some(r) = &c.ride {
+            positive("ride.wz_limit", r.wz_limit)?;
+            positive("ride.min_seconds", r.min_seconds)?;
+            if !(r.band_hz[0] > 0.0 && r.band_hz[1] > r.band_hz[0]) {
+                return Err(Error::config(
+                    path,
+                    "ride.band_hz",
+                    "two frequencies, low < high",
+                ));
+            }
+        }
         if !(c.chinese.min_duration_s.is_finite() && c.chinese.min_duration_s >= 0.0) {
             return Err(Error::config(
                 path,
@@ -234,6 +261,7 @@ mod tests {
             &c.vertical.source,
             &c.lateral_quasi_static.source,
             &c.chinese.source,
+            &c.ride.as_ref().unwrap().source,
         ] {
             assert!(s.len() > 20, "{s}");
         }

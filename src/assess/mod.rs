@@ -9,6 +9,7 @@
 //! (`w1l_force_y_N`) alike: the same statistics of true and identified forces.
 
 pub mod criteria;
+pub mod ride;
 pub mod statistics;
 
 use crate::dsp::{Butterworth, percentile};
@@ -40,6 +41,9 @@ pub struct RunForces {
     pub s: Vec<f64>,
     /// Every wheel with both forces, in column order.
     pub wheels: Vec<WheelSeries>,
+    /// Carbody lateral and vertical accelerations, m/s², where the run has them (the ride
+    /// index).
+    pub carbody: Option<[Vec<f64>; 2]>,
 }
 
 impl RunForces {
@@ -92,7 +96,25 @@ impl RunForces {
                 )));
             }
         }
-        Ok(RunForces { time, s, wheels })
+        let carbody = find("carbody_acc_y")
+            .zip(find("carbody_acc_z"))
+            .map(|(y, z)| [y, z]);
+        if let Some(r) = carbody
+            .iter()
+            .flat_map(|c| c.iter())
+            .find_map(|v| v.iter().position(|x| !x.is_finite()))
+        {
+            return Err(Error::Domain(format!(
+                "{source}: carbody acceleration, row {}: not a finite number",
+                r + 1
+            )));
+        }
+        Ok(RunForces {
+            time,
+            s,
+            wheels,
+            carbody,
+        })
     }
 }
 
@@ -367,6 +389,34 @@ pub fn assess(
                 criterion: "chinese".into(),
             });
         }
+        if let (Some(ride), Some(acc)) = (&c.ride, &run.carbody)
+            && idx.len() as f64 / fs >= ride.min_seconds
+        {
+            for (k, (dir, name)) in [
+                (ride::Direction::Lateral, "Wz lateral"),
+                (ride::Direction::Vertical, "Wz vertical"),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let wz =
+                    ride::sperling(&pick(&acc[k]), fs, dir, (ride.band_hz[0], ride.band_hz[1]));
+                rows.push(Row {
+                    section: span.name.clone(),
+                    quantity: name.into(),
+                    place: "carbody".into(),
+                    value: wz,
+                    limit: ride.wz_limit,
+                    unit: "-".into(),
+                    statistic: format!(
+                        "Sperling over the section's spectrum, {}–{} Hz",
+                        ride.band_hz[0], ride.band_hz[1]
+                    ),
+                    pass: wz <= ride.wz_limit,
+                    criterion: "ride".into(),
+                });
+            }
+        }
     }
     if rows.is_empty() {
         return Err(Error::Domain(format!(
@@ -438,6 +488,9 @@ impl Assessment {
             ("chinese", &c.chinese.source),
         ] {
             s += &format!("- `{k}`: {src}\n");
+        }
+        if let Some(r) = &c.ride {
+            s += &format!("- `ride`: {}\n", r.source);
         }
         s
     }

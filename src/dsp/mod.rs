@@ -1,9 +1,11 @@
 //! Signal processing shared by several stages (spectral estimates, filters).
 
 pub mod butterworth;
+pub mod spectrum;
 pub mod stats;
 pub mod welch;
 
 pub use butterworth::Butterworth;
+pub use spectrum::amplitude_spectrum;
 pub use stats::percentile;
 pub use welch::{WelchPsd, welch_psd};
