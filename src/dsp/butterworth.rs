@@ -25,7 +25,10 @@ impl Butterworth {
     /// When `order` is odd or zero, or `fc` is not inside (0, fs/2).
     pub fn lowpass(order: usize, fc: f64, fs: f64) -> Self {
         use std::f64::consts::PI;
-        assert!(order >= 2 && order % 2 == 0, "even order ≥ 2, got {order}");
+        assert!(
+            order >= 2 && order.is_multiple_of(2),
+            "even order ≥ 2, got {order}"
+        );
         assert!(
             fc > 0.0 && fc < fs / 2.0,
             "cut-off {fc} Hz outside (0, {}) Hz",
