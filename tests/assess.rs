@@ -198,3 +198,23 @@ fn a_slow_run_on_smooth_track_passes() {
         "the run records the carbody accelerations"
     );
 }
+
+/// A wheelset hunting at 1.5 Hz: ΣY of amplitude A has a sliding rms of A/√2 over 100 m;
+/// 40 kN passes the stability limit (half the track-shifting limit, 39 kN), 70 kN fails.
+#[test]
+fn planted_hunting_is_caught_by_the_stability_criterion() {
+    let hunt = |amp: f64| {
+        let mut r = run(300.0, |_, _| 0.0, |_, _| 122.6e3);
+        r.wheels[0].y = r
+            .time
+            .iter()
+            .map(|t| amp * (2.0 * std::f64::consts::PI * 1.5 * t).sin())
+            .collect();
+        let a = assess(&r, &[], &Criteria::builtin(), 122.6).unwrap();
+        value(&a, "whole run", "(ΣY)rms", "wheelset 1")
+    };
+    let (rms, pass) = hunt(40e3);
+    assert!((rms - 40.0 / 2f64.sqrt()).abs() < 1.0 && pass, "{rms}");
+    let (rms, pass) = hunt(70e3);
+    assert!((rms - 70.0 / 2f64.sqrt()).abs() < 1.5 && !pass, "{rms}");
+}

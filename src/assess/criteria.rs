@@ -119,6 +119,22 @@ pub struct Ride {
     pub source: String,
 }
 
+/// Running stability on ΣY.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stability {
+    /// Half width of the band around the dominant frequency, Hz.
+    pub band_half_width_hz: f64,
+    /// Sliding rms window, m.
+    pub window_m: f64,
+    /// Step between windows, m.
+    pub step_m: f64,
+    /// Limit as a share of the track-shifting limit (ΣY)lim.
+    pub limit_ratio: f64,
+    /// Where it comes from.
+    pub source: String,
+}
+
 /// Every criterion of an assessment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -143,6 +159,8 @@ pub struct Criteria {
     pub chinese: Chinese,
     /// Ride index from the carbody accelerations (absent: not assessed).
     pub ride: Option<Ride>,
+    /// Running stability (absent: not assessed).
+    pub stability: Option<Stability>,
 }
 
 impl Criteria {
@@ -232,6 +250,12 @@ impl Criteria {
                 ));
             }
         }
+        if let Some(st) = &c.stability {
+            positive("stability.band_half_width_hz", st.band_half_width_hz)?;
+            positive("stability.window_m", st.window_m)?;
+            positive("stability.step_m", st.step_m)?;
+            positive("stability.limit_ratio", st.limit_ratio)?;
+        }
         if !(c.chinese.min_duration_s.is_finite() && c.chinese.min_duration_s >= 0.0) {
             return Err(Error::config(
                 path,
@@ -262,6 +286,7 @@ mod tests {
             &c.lateral_quasi_static.source,
             &c.chinese.source,
             &c.ride.as_ref().unwrap().source,
+            &c.stability.as_ref().unwrap().source,
         ] {
             assert!(s.len() > 20, "{s}");
         }

@@ -342,6 +342,50 @@ pub fn assess(
                 );
             }
         }
+        // Running stability: ΣY around its dominant frequency, as a sliding rms over distance.
+        if let Some(st) = &c.stability
+            && covered >= st.window_m
+        {
+            for axle in 1..=wheels.len() {
+                let find = |side: char| wheels.iter().find(|w| w.wheel == format!("w{axle}{side}"));
+                let (Some(l), Some(r)) = (find('l'), find('r')) else {
+                    continue;
+                };
+                let sum: Vec<f64> = pick(&l.y)
+                    .iter()
+                    .zip(pick(&r.y))
+                    .map(|(a, b)| (a + b) / 1000.0)
+                    .collect();
+                let Some(f0) = statistics::dominant_frequency(&sum, fs, 0.5, c.filter.lowpass_hz)
+                else {
+                    continue;
+                };
+                let band = statistics::band_pass(
+                    &sum,
+                    fs,
+                    f0 - st.band_half_width_hz,
+                    f0 + st.band_half_width_hz,
+                    c.filter.order,
+                );
+                let sq: Vec<f64> = band.iter().map(|v| v * v).collect();
+                let rms = sliding_mean(&s, &sq, st.window_m, st.step_m)
+                    .into_iter()
+                    .map(|p| p.1.sqrt())
+                    .fold(0.0f64, f64::max);
+                push(
+                    "(ΣY)rms",
+                    &format!("wheelset {axle}"),
+                    rms,
+                    st.limit_ratio * c.track_shift.alpha * (10.0 + 2.0 * q0_kn / 3.0),
+                    "kN",
+                    format!(
+                        "largest sliding rms over {} m every {} m of ΣY band-passed at f0 = {f0:.2} Hz ± {} Hz; limit {}·(ΣY)lim",
+                        st.window_m, st.step_m, st.band_half_width_hz, st.limit_ratio
+                    ),
+                    "stability",
+                );
+            }
+        }
         // The Chinese criteria with their time criterion, through the one safety monitor.
         let id = Identified {
             targets: wheels
@@ -491,6 +535,9 @@ impl Assessment {
         }
         if let Some(r) = &c.ride {
             s += &format!("- `ride`: {}\n", r.source);
+        }
+        if let Some(st) = &c.stability {
+            s += &format!("- `stability`: {}\n", st.source);
         }
         s
     }

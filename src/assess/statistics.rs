@@ -41,6 +41,29 @@ pub fn sliding_mean(s: &[f64], x: &[f64], window: f64, step: f64) -> Vec<(f64, f
     out
 }
 
+/// Zero-phase band-pass of `x` (sampled at `fs`) between `lo` and `hi` Hz: the `hi` low-pass
+/// of `x` minus its own `lo` low-pass (both `order`, forward and backward). `lo` ≤ 0 keeps
+/// everything below `hi`.
+pub fn band_pass(x: &[f64], fs: f64, lo: f64, hi: f64, order: usize) -> Vec<f64> {
+    use crate::dsp::Butterworth;
+    let hi = hi.min(0.45 * fs);
+    let low = Butterworth::lowpass(order, hi, fs).filtfilt(x);
+    if lo <= 0.0 {
+        return low;
+    }
+    let base = Butterworth::lowpass(order, lo, fs).filtfilt(&low);
+    low.iter().zip(base).map(|(a, b)| a - b).collect()
+}
+
+/// The frequency of the largest spectral line of `x` within `(lo, hi)` Hz.
+pub fn dominant_frequency(x: &[f64], fs: f64, lo: f64, hi: f64) -> Option<f64> {
+    crate::dsp::amplitude_spectrum(x, fs)
+        .into_iter()
+        .filter(|(f, _)| *f > lo && *f < hi)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|p| p.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -63,6 +86,22 @@ mod tests {
         for (c, v) in &m {
             assert!((v - (3.0 * c + 1.0)).abs() < 1e-9, "{c}: {v}");
         }
+    }
+
+    #[test]
+    fn band_pass_keeps_the_band_and_finds_its_line() {
+        let fs = 200.0;
+        let x: Vec<f64> = (0..8000)
+            .map(|i| {
+                let t = i as f64 / fs;
+                let w = 2.0 * std::f64::consts::PI;
+                (w * 3.0 * t).sin() + 0.5 * (w * 0.2 * t).sin() + 0.5 * (w * 30.0 * t).sin()
+            })
+            .collect();
+        assert_eq!(dominant_frequency(&x, fs, 1.0, 10.0), Some(3.0));
+        let b = band_pass(&x, fs, 1.0, 5.0, 4);
+        let peak = b[2000..6000].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!((peak - 1.0).abs() < 0.05, "the 3 Hz line passes: {peak}");
     }
 
     #[test]
