@@ -81,6 +81,15 @@ fn every_experiment_runs_end_to_end() {
         "condition,n,fl_mse,fl_r2,var_fl_test,fq_mse,fq_r2,var_fq_test,paper_fq_mse,paper_fq_r2"
     ));
     assert!(header("generalization/leave_one_out.csv").starts_with("held_out_condition,"));
+    // The test runs judged by the acceptance statistics, identified against true.
+    assert!(
+        header("generalization/assessment.csv")
+            .starts_with("condition,y_q_2m_true,y_q_2m_identified_true,q_true,q_identified_true"),
+        "{}",
+        header("generalization/assessment.csv")
+    );
+    let assessed = std::fs::read_to_string(out.join("generalization/assessment.csv")).unwrap();
+    assert_eq!(assessed.lines().count(), 4, "three conditions: {assessed}");
     assert_eq!(
         header("robustness/robustness.csv"),
         "protocol,snr_db,model,fl_mse,fl_r2,fq_mse,fq_r2,paper_r2_at_1_db"

@@ -7,6 +7,7 @@
 //! `index.html`, with seeds, data identity, protocol, noise definition, label position,
 //! versions and timings.
 
+mod assessment;
 mod comparison;
 mod generalization;
 pub mod paper;
@@ -326,6 +327,10 @@ struct FitJob<'d> {
 /// The columns the experiments keep (time, labels, the candidates): the rest is dropped.
 fn slim(ds: &DataSet, candidates: Candidates) -> Result<DataSet> {
     let mut keep: Vec<String> = vec!["time_s".into()];
+    // The track position: the acceptance statistics are sliding means over distance.
+    if ds.channel("s_m").is_ok() {
+        keep.push("s_m".into());
+    }
     keep.extend(ds.labels.iter().cloned());
     keep.extend(candidates.among(&ds.names, &ds.labels));
     ds.subset(None, Some(&keep))
