@@ -218,3 +218,37 @@ fn planted_hunting_is_caught_by_the_stability_criterion() {
     let (rms, pass) = hunt(70e3);
     assert!((rms - 70.0 / 2f64.sqrt()).abs() < 1.5 && !pass, "{rms}");
 }
+
+/// Carbody accelerations: a 2 m/s² sine at 3 Hz lies in the 0.4–10 Hz band and reads 2 m/s²
+/// (within the 3 m/s² lateral limit); gravity and a 0.1 Hz sway are outside it; 4 m/s²
+/// laterally fails. The ride index of the same motion is its Sperling value.
+#[test]
+fn carbody_accelerations_in_their_band() {
+    let with = |amp: f64| {
+        let mut r = run(300.0, |_, _| 0.0, |_, _| 122.6e3);
+        let w = 2.0 * std::f64::consts::PI;
+        let y: Vec<f64> = r
+            .time
+            .iter()
+            .map(|t| amp * (w * 3.0 * t).sin() + 1.0 * (w * 0.1 * t).sin())
+            .collect();
+        let z: Vec<f64> = r.time.iter().map(|_| 9.81).collect();
+        r.carbody = Some([y, z]);
+        assess(&r, &[], &Criteria::builtin(), 122.6).unwrap()
+    };
+    let a = with(2.0);
+    let (ay, pass) = value(&a, "whole run", "ÿ* lateral (0.4–10 Hz)", "carbody");
+    assert!((ay - 2.0).abs() < 0.05 && pass, "{ay}");
+    let (az, _) = value(&a, "whole run", "z̈* vertical (0.4–10 Hz)", "carbody");
+    assert!(
+        az < 1e-6,
+        "gravity is not an acceleration of the ride: {az}"
+    );
+    let (_, pass) = value(&with(4.0), "whole run", "ÿ* lateral (0.4–10 Hz)", "carbody");
+    assert!(!pass);
+    // Sperling by hand: A = 2/9.81 g at 3 Hz, lateral F = 0.8·3² = 7.2 (the 0.1 Hz sway is
+    // below the 0.5 Hz band): 7.08·(A³·7.2/3)^0.1 = 4.797, beyond the freight 4.25.
+    let (wz, pass) = value(&a, "whole run", "Wz lateral", "carbody");
+    let by_hand = 7.08 * ((2.0f64 / 9.81).powi(3) * 7.2 / 3.0).powf(0.1);
+    assert!((wz - by_hand).abs() < 0.01 && !pass, "{wz} vs {by_hand}");
+}

@@ -135,6 +135,20 @@ pub struct Stability {
     pub source: String,
 }
 
+/// Carbody accelerations (running behaviour).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CarbodyAcceleration {
+    /// Band, Hz.
+    pub band_hz: [f64; 2],
+    /// Lateral limit of max(|F1|, |F2|), m/s².
+    pub lateral_limit: f64,
+    /// Vertical limit, m/s².
+    pub vertical_limit: f64,
+    /// Where it comes from.
+    pub source: String,
+}
+
 /// Every criterion of an assessment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -161,6 +175,8 @@ pub struct Criteria {
     pub ride: Option<Ride>,
     /// Running stability (absent: not assessed).
     pub stability: Option<Stability>,
+    /// Carbody accelerations (absent: not assessed).
+    pub carbody_acceleration: Option<CarbodyAcceleration>,
 }
 
 impl Criteria {
@@ -250,6 +266,17 @@ impl Criteria {
                 ));
             }
         }
+        if let Some(a) = &c.carbody_acceleration {
+            positive("carbody_acceleration.lateral_limit", a.lateral_limit)?;
+            positive("carbody_acceleration.vertical_limit", a.vertical_limit)?;
+            if !(a.band_hz[0] > 0.0 && a.band_hz[1] > a.band_hz[0]) {
+                return Err(Error::config(
+                    path,
+                    "carbody_acceleration.band_hz",
+                    "two frequencies, low < high",
+                ));
+            }
+        }
         if let Some(st) = &c.stability {
             positive("stability.band_half_width_hz", st.band_half_width_hz)?;
             positive("stability.window_m", st.window_m)?;
@@ -287,6 +314,7 @@ mod tests {
             &c.chinese.source,
             &c.ride.as_ref().unwrap().source,
             &c.stability.as_ref().unwrap().source,
+            &c.carbody_acceleration.as_ref().unwrap().source,
         ] {
             assert!(s.len() > 20, "{s}");
         }

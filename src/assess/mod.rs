@@ -433,6 +433,41 @@ pub fn assess(
                 criterion: "chinese".into(),
             });
         }
+        if let (Some(ca), Some(acc)) = (&c.carbody_acceleration, &run.carbody) {
+            for (k, (name, limit)) in [
+                ("ÿ* lateral (0.4–10 Hz)", ca.lateral_limit),
+                ("z̈* vertical (0.4–10 Hz)", ca.vertical_limit),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let band = statistics::band_pass(
+                    &acc[k],
+                    fs,
+                    ca.band_hz[0],
+                    ca.band_hz[1],
+                    c.filter.order,
+                );
+                let band = pick(&band);
+                let v = percentile(&band, pct.low)
+                    .abs()
+                    .max(percentile(&band, pct.high).abs());
+                rows.push(Row {
+                    section: span.name.clone(),
+                    quantity: name.into(),
+                    place: "carbody".into(),
+                    value: v,
+                    limit,
+                    unit: "m/s²".into(),
+                    statistic: format!(
+                        "max(|F1|, |F2|) of the acceleration band-passed {}–{} Hz, F1 = {} %, F2 = {} %",
+                        ca.band_hz[0], ca.band_hz[1], pct.low, pct.high
+                    ),
+                    pass: v <= limit,
+                    criterion: "carbody_acceleration".into(),
+                });
+            }
+        }
         if let (Some(ride), Some(acc)) = (&c.ride, &run.carbody)
             && idx.len() as f64 / fs >= ride.min_seconds
         {
@@ -538,6 +573,9 @@ impl Assessment {
         }
         if let Some(st) = &c.stability {
             s += &format!("- `stability`: {}\n", st.source);
+        }
+        if let Some(a) = &c.carbody_acceleration {
+            s += &format!("- `carbody_acceleration`: {}\n", a.source);
         }
         s
     }

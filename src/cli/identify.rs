@@ -10,17 +10,20 @@ use std::fmt::Write as _;
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
-/// Limits of the safety indices (defaults: commonly quoted Chinese values, secondary sources).
+/// Limits of the safety indices: by default the `[chinese]` table of the assessment criteria
+/// (`vehicles/assessment.toml`: commonly quoted Chinese values, secondary sources), so
+/// `identify`, `validate identify` and `assess` judge with the same numbers.
 #[derive(Debug, Args, Clone)]
 pub struct LimitArgs {
-    /// Derailment coefficient |Y|/Q limit (1.2 allowable, 1.0 preferred).
-    #[arg(long, default_value_t = 1.2)]
-    pub limit_yq: f64,
-    /// Wheel unloading ΔQ/Q̄ limit (0.65 allowable, 0.60 preferred).
-    #[arg(long, default_value_t = 0.65)]
-    pub limit_unloading: f64,
+    /// Derailment coefficient |Y|/Q limit [default: the criteria's, 1.2 allowable; 1.0 is
+    /// the preferred value].
+    #[arg(long)]
+    pub limit_yq: Option<f64>,
+    /// Wheel unloading ΔQ/Q̄ limit [default: the criteria's, 0.65 allowable; 0.60 preferred].
+    #[arg(long)]
+    pub limit_unloading: Option<f64>,
     /// Static wheel load Q̄, kN [default: the --vehicle's weight over its wheels]; H's limit
-    /// 0.85·(10 + P_st/3) follows from it.
+    /// α·(10 + P_st/3) follows from it.
     #[arg(long)]
     pub static_wheel_load_kn: Option<f64>,
     /// Vehicle whose weight gives the static wheel load (C80 loaded: 100 t on 8 wheels →
@@ -28,10 +31,14 @@ pub struct LimitArgs {
     #[arg(long, default_value = "vehicles/c80.toml")]
     pub vehicle: PathBuf,
     /// Time criterion, ms: an excursion above a limit counts as an exceedance when it lasts
-    /// at least this long (shorter ones are reported as brief). Default 50 ms, the commonly
-    /// quoted Chinese criterion (secondary source); 0 counts every sample.
-    #[arg(long, default_value_t = 50.0)]
-    pub min_duration_ms: f64,
+    /// at least this long (shorter ones are reported as brief) [default: the criteria's,
+    /// 50 ms]; 0 counts every sample.
+    #[arg(long)]
+    pub min_duration_ms: Option<f64>,
+    /// Criteria file whose `[chinese]` table gives the defaults above [default: the built-in
+    /// vehicles/assessment.toml].
+    #[arg(long)]
+    pub criteria: Option<PathBuf>,
 }
 
 impl LimitArgs {
@@ -44,18 +51,21 @@ impl LimitArgs {
                 v.mass() * railforce::GRAVITY / (2 * v.contact.wheelsets.len()) as f64 * 1e-3
             }
         };
-        if !(self.min_duration_ms.is_finite() && self.min_duration_ms >= 0.0) {
-            bail!(
-                "--min-duration-ms {}: give a duration ≥ 0",
-                self.min_duration_ms
-            );
+        let criteria = match &self.criteria {
+            Some(p) => railforce::assess::Criteria::load(&super::builtin::resolve(p)?)?,
+            None => railforce::assess::Criteria::builtin(),
+        };
+        let c = &criteria.chinese;
+        let min_ms = self.min_duration_ms.unwrap_or(c.min_duration_s * 1000.0);
+        if !(min_ms.is_finite() && min_ms >= 0.0) {
+            bail!("--min-duration-ms {min_ms}: give a duration ≥ 0");
         }
         Ok(Limits {
-            y_over_q: self.limit_yq,
-            unloading: self.limit_unloading,
+            y_over_q: self.limit_yq.unwrap_or(c.derailment),
+            unloading: self.limit_unloading.unwrap_or(c.unloading),
             static_wheel_load_kn,
-            min_duration_s: self.min_duration_ms / 1000.0,
-            ..Limits::default()
+            min_duration_s: min_ms / 1000.0,
+            lateral_alpha: c.lateral_alpha,
         })
     }
 }

@@ -87,23 +87,35 @@ impl Butterworth {
         }
     }
 
-    /// Zero-phase filtering of a whole record: forward, then backward, each pass started in
-    /// the steady state of its first value (no start transient). The gain is [`Self::gain`]
-    /// squared and the phase zero, so peaks stay where they were.
+    /// Zero-phase filtering of a whole record: forward, then backward (gain [`Self::gain`]
+    /// squared, no phase, so peaks stay where they were). As scipy's `filtfilt`, the record
+    /// is first extended at both ends by its odd reflection (`2·x₀ − x_k`), here over three
+    /// time constants of the cut-off (`3·fs/fc` samples, at most the record), and each pass
+    /// starts in the steady state of its first value: ramps and slow swings do not ring at
+    /// the ends.
     pub fn filtfilt(&self, x: &[f64]) -> Vec<f64> {
-        let mut state = vec![0.0; self.order()];
-        let pass = |input: &mut dyn Iterator<Item = f64>, first: f64, state: &mut [f64]| {
-            self.steady_state(first, state);
-            input.map(|v| self.step(v, state)).collect::<Vec<f64>>()
-        };
-        let Some(&first) = x.first() else {
+        let n = x.len();
+        if n == 0 {
             return Vec::new();
-        };
-        let forward = pass(&mut x.iter().copied(), first, &mut state);
-        let last = *forward.last().expect("non-empty");
-        let mut back = pass(&mut forward.iter().rev().copied(), last, &mut state);
+        }
+        let fc = self.k.atan() * self.fs / std::f64::consts::PI;
+        let pad = ((3.0 * self.fs / fc).ceil() as usize).min(n - 1);
+        let (first, last) = (x[0], x[n - 1]);
+        let mut ext = Vec::with_capacity(n + 2 * pad);
+        ext.extend((1..=pad).rev().map(|k| 2.0 * first - x[k]));
+        ext.extend_from_slice(x);
+        ext.extend((1..=pad).map(|k| 2.0 * last - x[n - 1 - k]));
+        let mut state = vec![0.0; self.order()];
+        self.steady_state(ext[0], &mut state);
+        let forward: Vec<f64> = ext.iter().map(|&v| self.step(v, &mut state)).collect();
+        self.steady_state(forward[forward.len() - 1], &mut state);
+        let mut back: Vec<f64> = forward
+            .iter()
+            .rev()
+            .map(|&v| self.step(v, &mut state))
+            .collect();
         back.reverse();
-        back
+        back[pad..pad + n].to_vec()
     }
 }
 
@@ -141,6 +153,24 @@ mod tests {
         let mut st = vec![0.0; 8];
         lp.steady_state(3.0, &mut st);
         assert!((lp.step(3.0, &mut st) - 3.0).abs() < 1e-12);
+    }
+
+    /// A ramp and a slow sine come through a low cut-off unchanged to the very ends.
+    #[test]
+    fn zero_phase_keeps_the_ends_of_slow_signals() {
+        let lp = Butterworth::lowpass(4, 0.4, 200.0);
+        let x: Vec<f64> = (0..6000)
+            .map(|i| {
+                let t = i as f64 / 200.0;
+                2.0 * t + (2.0 * std::f64::consts::PI * 0.1 * t).sin()
+            })
+            .collect();
+        let y = lp.filtfilt(&x);
+        let worst = x
+            .iter()
+            .zip(&y)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(worst < 0.02, "{worst}");
     }
 
     /// The assessment's 20 Hz filter (4th order, forward and backward at 200 Hz): its
