@@ -166,6 +166,16 @@ fn track_files_parse_or_say_why() {
 }
 
 #[test]
+fn criteria_files_parse_or_say_why() {
+    fuzz(
+        "criteria",
+        &root().join("vehicles/assessment.toml"),
+        &[],
+        |p| railforce::assess::Criteria::load(p),
+    );
+}
+
+#[test]
 fn plan_files_parse_or_say_why() {
     fuzz("plan", &root().join("tracks/demo.plan.toml"), &[], |p| {
         railforce::plan::Plan::load(p)
