@@ -171,7 +171,7 @@ fn criteria_files_parse_or_say_why() {
         "criteria",
         &root().join("vehicles/assessment.toml"),
         &[],
-        |p| railforce::assess::Criteria::load(p),
+        railforce::assess::Criteria::load,
     );
 }
 
