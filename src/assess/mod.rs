@@ -320,48 +320,40 @@ pub fn assess(
                 );
             }
         }
-        for axle in 1..=wheels.len() {
-            let find = |side: char| wheels.iter().find(|w| w.wheel == format!("w{axle}{side}"));
-            if let (Some(l), Some(r)) = (find('l'), find('r')) {
-                let sum: Vec<f64> = pick(&l.y)
-                    .iter()
-                    .zip(pick(&r.y))
-                    .map(|(a, b)| (a + b) / 1000.0)
-                    .collect();
-                push(
-                    "(ΣY)2m",
-                    &format!("wheelset {axle}"),
-                    two_sided(&sum),
-                    c.track_shift.alpha * (10.0 + 2.0 * q0_kn / 3.0),
-                    "kN",
-                    format!(
-                        "{sliding_words}; limit α·(10 + 2·Q0/3), α = {}",
-                        c.track_shift.alpha
-                    ),
-                    "track_shift",
-                );
-            }
+        // ΣY = Y_l + Y_r (kN) of every wheelset with both wheels, once for both criteria.
+        let axle_sums: Vec<(usize, Vec<f64>)> = (1..=wheels.len())
+            .filter_map(|axle| {
+                let find = |side: char| wheels.iter().find(|w| w.wheel == format!("w{axle}{side}"));
+                let (l, r) = (find('l')?, find('r')?);
+                let sum = idx.iter().map(|&i| (l.y[i] + r.y[i]) / 1000.0).collect();
+                Some((axle, sum))
+            })
+            .collect();
+        for (axle, sum) in &axle_sums {
+            push(
+                "(ΣY)2m",
+                &format!("wheelset {axle}"),
+                two_sided(sum),
+                c.track_shift.alpha * (10.0 + 2.0 * q0_kn / 3.0),
+                "kN",
+                format!(
+                    "{sliding_words}; limit α·(10 + 2·Q0/3), α = {}",
+                    c.track_shift.alpha
+                ),
+                "track_shift",
+            );
         }
         // Running stability: ΣY around its dominant frequency, as a sliding rms over distance.
         if let Some(st) = &c.stability
             && covered >= st.window_m
         {
-            for axle in 1..=wheels.len() {
-                let find = |side: char| wheels.iter().find(|w| w.wheel == format!("w{axle}{side}"));
-                let (Some(l), Some(r)) = (find('l'), find('r')) else {
-                    continue;
-                };
-                let sum: Vec<f64> = pick(&l.y)
-                    .iter()
-                    .zip(pick(&r.y))
-                    .map(|(a, b)| (a + b) / 1000.0)
-                    .collect();
-                let Some(f0) = statistics::dominant_frequency(&sum, fs, 0.5, c.filter.lowpass_hz)
+            for (axle, sum) in &axle_sums {
+                let Some(f0) = statistics::dominant_frequency(sum, fs, 0.5, c.filter.lowpass_hz)
                 else {
                     continue;
                 };
                 let band = statistics::band_pass(
-                    &sum,
+                    sum,
                     fs,
                     f0 - st.band_half_width_hz,
                     f0 + st.band_half_width_hz,

@@ -51,7 +51,7 @@ pub fn run(args: AssessArgs) -> Result<()> {
         Some(q) => anyhow::bail!("--static-wheel-load-kn must be positive, got {q}"),
         None => {
             let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&args.vehicle)?)?;
-            v.mass() * railforce::GRAVITY / (2 * v.contact.wheelsets.len()) as f64 * 1e-3
+            v.static_wheel_load_kn()
         }
     };
     let cols = railforce::features::read_table(&args.file)?;

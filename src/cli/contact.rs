@@ -245,11 +245,9 @@ pub fn run(args: ContactArgs) -> Result<()> {
         )?),
         None => None,
     };
-    let load_kn = args.load_kn.unwrap_or_else(|| {
-        vehicle.as_ref().map_or(122.6, |v| {
-            v.mass() * railforce::GRAVITY / (2 * v.contact.wheelsets.len()) as f64 * 1e-3
-        })
-    });
+    let load_kn = args
+        .load_kn
+        .unwrap_or_else(|| vehicle.as_ref().map_or(122.6, |v| v.static_wheel_load_kn()));
     if !(load_kn > 0.0 && args.speed_kmh > 0.0 && args.mu > 0.0) {
         bail!("--load-kn, --speed-kmh and --mu must be positive");
     }

@@ -48,7 +48,7 @@ impl LimitArgs {
             None => {
                 let v =
                     railforce::vehicle::Vehicle::load(&super::builtin::resolve(&self.vehicle)?)?;
-                v.mass() * railforce::GRAVITY / (2 * v.contact.wheelsets.len()) as f64 * 1e-3
+                v.static_wheel_load_kn()
             }
         };
         let criteria = match &self.criteria {

@@ -118,7 +118,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     // The test runs judged by the acceptance statistics, identified against true.
     let plan = crate::plan::Plan::load(&opts.plan)?;
     let vehicle = crate::vehicle::Vehicle::load(&plan.vehicle)?;
-    let q0 = vehicle.mass() * crate::GRAVITY / (2 * vehicle.contact.wheelsets.len()) as f64 * 1e-3;
+    let q0 = vehicle.static_wheel_load_kn();
     let per_assess =
         super::assessment::checks(&ev.rows, &model.meta.data.targets, &ctx.ds, &plan, q0)?;
     let (assess_table, assess_chart) = super::assessment::report(&per_assess);

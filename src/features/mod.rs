@@ -3,6 +3,7 @@
 
 pub mod mutual_info;
 pub mod samples;
+pub mod split;
 pub mod wrapper;
 
 pub use samples::{

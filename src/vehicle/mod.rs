@@ -174,6 +174,11 @@ impl Vehicle {
         self.bodies.iter().map(|b| b.mass).sum()
     }
 
+    /// Static wheel load Q0, kN: the weight shared by all wheels (C80 loaded: 122.6 kN).
+    pub fn static_wheel_load_kn(&self) -> f64 {
+        self.mass() * crate::GRAVITY / (2 * self.contact.wheelsets.len()) as f64 * 1e-3
+    }
+
     /// Index of a body by name.
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
