@@ -81,7 +81,9 @@ fn strip_grid(wheel: &super::profile::Profile) -> Vec<(f64, f64)> {
 #[derive(Debug, Clone, Default)]
 pub struct StripTable {
     windows: Vec<[Window; 2]>,
-    strips: Vec<Strip>,
+    /// What a penetrated strip contributes, interpolated between tabulated shifts lane by
+    /// lane: `[stiffness, angle, z, radius, curvature_sum, ma, mb, k_over_e]` (see [`Strip`]).
+    strips: Vec<[f64; 8]>,
     /// Gap and lateral position of every strip, apart: the hot data of the search.
     gap_y: Vec<[f64; 2]>,
 }
@@ -228,7 +230,19 @@ impl StripTable {
                     narrow: (first + from as u32, first + to as u32),
                 };
                 table.gap_y.extend(strips.iter().map(|g| [g.gap, g.y]));
-                table.strips.extend(strips);
+                table.strips.extend(strips.iter().map(|g| {
+                    let h = &g.hertz;
+                    [
+                        g.stiffness,
+                        g.angle,
+                        g.z,
+                        g.radius,
+                        h.curvature_sum,
+                        h.ma,
+                        h.mb,
+                        h.k_over_e,
+                    ]
+                }));
             }
             table.windows.push(w);
         }
@@ -271,13 +285,15 @@ impl StripTable {
         }
         let mut out: [Option<PatchLoad>; 2] = [None, None];
         let mut least = f64::INFINITY;
-        // Running sums of the current zone: N, dN/dδ, N·angle, N·y, N·z, N·r, and N times the
-        // Hertz shape's four numbers.
-        let mut acc: Option<[f64; 10]> = None;
-        let close = |acc: &mut Option<[f64; 10]>, out: &mut [Option<PatchLoad>; 2]| {
-            let Some(a) = acc.take() else {
+        // Running sums of the current zone: N, N·y, dN/dδ, then N times the other seven
+        // interpolated numbers (angle, z, radius and the Hertz shape's four).
+        let mut acc = [0.0; 10];
+        let mut open = false;
+        let close = |acc: &mut [f64; 10], open: &mut bool, out: &mut [Option<PatchLoad>; 2]| {
+            if !std::mem::take(open) {
                 return;
-            };
+            }
+            let a = std::mem::take(acc);
             if a[0] <= 0.0 {
                 return;
             }
@@ -289,9 +305,9 @@ impl StripTable {
             };
             let p = PatchLoad {
                 normal: a[0] * e_star,
-                stiffness: a[1] * e_star,
-                angle: a[2] / a[0],
-                y: a[3] / a[0],
+                stiffness: a[2] * e_star,
+                angle: a[3] / a[0],
+                y: a[1] / a[0],
                 z: a[4] / a[0],
                 radius: a[5] / a[0],
                 hertz,
@@ -316,39 +332,48 @@ impl StripTable {
                 }
             }
         };
-        for j in j0..j1 {
-            let (ia, ib) = (
-                (w0.offset + j - w0.first) as usize,
-                (w1.offset + j - w1.first) as usize,
-            );
-            let ([ga, ya], [gb, yb]) = (self.gap_y[ia], self.gap_y[ib]);
-            let y = ya + t * (yb - ya);
-            let d = approach - roll * y - (ga + t * (gb - ga));
-            least = least.min(-d);
-            if d <= 0.0 {
-                close(&mut acc, &mut out);
-                continue;
+        // Two passes per chunk of strips: the interpolated lateral position and penetration of
+        // each (a tight loop over contiguous gaps), then the sums over the penetrated ones.
+        const CHUNK: usize = 32;
+        let count = j1.saturating_sub(j0) as usize;
+        let ia0 = (w0.offset + j0.min(j1) - w0.first) as usize;
+        let ib0 = (w1.offset + j0.min(j1) - w1.first) as usize;
+        let (mut ys, mut ds) = ([0.0; CHUNK], [0.0; CHUNK]);
+        for start in (0..count).step_by(CHUNK) {
+            let len = CHUNK.min(count - start);
+            let ga = &self.gap_y[ia0 + start..ia0 + start + len];
+            let gb = &self.gap_y[ib0 + start..ib0 + start + len];
+            for m in 0..len {
+                let ([ga, ya], [gb, yb]) = (ga[m], gb[m]);
+                let y = ya + t * (yb - ya);
+                ys[m] = y;
+                ds[m] = approach - roll * y - (ga + t * (gb - ga));
             }
-            let (a, b) = (&self.strips[ia], &self.strips[ib]);
-            let lerp = |x: f64, y: f64| x + t * (y - x);
-            let c = lerp(a.stiffness, b.stiffness);
-            let n = c * d;
-            let z = lerp(a.z, b.z);
-            let (angle, radius) = (lerp(a.angle, b.angle), lerp(a.radius, b.radius));
-            let e = acc.get_or_insert([0.0; 10]);
-            let (ha, hb) = (&a.hertz, &b.hertz);
-            e[0] += n;
-            e[1] += c;
-            e[2] += n * angle;
-            e[3] += n * y;
-            e[4] += n * z;
-            e[5] += n * radius;
-            e[6] += n * lerp(ha.curvature_sum, hb.curvature_sum);
-            e[7] += n * lerp(ha.ma, hb.ma);
-            e[8] += n * lerp(ha.mb, hb.mb);
-            e[9] += n * lerp(ha.k_over_e, hb.k_over_e);
+            for m in 0..len {
+                let (y, d) = (ys[m], ds[m]);
+                // `least.min(-d)` without its NaN handling on the critical path (the same
+                // value: a NaN `d` leaves `least` as it was either way).
+                if -d < least {
+                    least = -d;
+                }
+                if d <= 0.0 {
+                    close(&mut acc, &mut open, &mut out);
+                    continue;
+                }
+                open = true;
+                let (a, b) = (&self.strips[ia0 + start + m], &self.strips[ib0 + start + m]);
+                // Lane by lane `a + t·(b − a)`, as the scalar interpolation wrote it.
+                let q: [f64; 8] = std::array::from_fn(|l| a[l] + t * (b[l] - a[l]));
+                let n = q[0] * d;
+                acc[0] += n;
+                acc[1] += n * y;
+                acc[2] += q[0];
+                for l in 1..8 {
+                    acc[l + 2] += n * q[l];
+                }
+            }
         }
-        close(&mut acc, &mut out);
+        close(&mut acc, &mut open, &mut out);
         (out, least)
     }
 }

@@ -231,7 +231,7 @@ fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
     }
     for e in &v.elements {
         if let Some(d) = e.deflection(states) {
-            for (_, axis) in e.gauges(&v.bodies) {
+            for &axis in e.gauge_axes() {
                 put(d[axis]);
             }
         }

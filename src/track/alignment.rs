@@ -117,6 +117,9 @@ pub struct Alignment {
     nodes: Vec<(f64, f64, f64)>,
     /// Unit tangent `(cos θ, sin θ)` at each node.
     tangents: Vec<(f64, f64)>,
+    /// `lookup[k]`: the last node at or before `s = k` metres, where the search for a node
+    /// starts (the run asks for positions a hundred thousand times a second).
+    lookup: Vec<u32>,
 }
 
 /// 5-point Gauss–Legendre abscissae and weights on [-1, 1].
@@ -166,6 +169,7 @@ impl Alignment {
             pieces,
             nodes: Vec::new(),
             tangents: Vec::new(),
+            lookup: Vec::new(),
         };
         let (mut x, mut y) = (0.0, 0.0);
         a.nodes.push((0.0, 0.0, 0.0));
@@ -188,7 +192,30 @@ impl Alignment {
                 (cs, sn)
             })
             .collect();
+        let metres = a.length().ceil().max(0.0) as usize;
+        a.lookup = (0..=metres)
+            .map(|k| (a.nodes.partition_point(|n| n.0 <= k as f64).max(1) - 1) as u32)
+            .collect();
         a
+    }
+
+    /// Index of the last node at or before `s` (the first node when none is): the same
+    /// index as a binary search over all nodes, found from the metre lookup by a short walk.
+    #[inline]
+    fn node_index(&self, s: f64) -> usize {
+        let last = self.nodes.len() - 1;
+        let k = if s > 0.0 { s as usize } else { 0 };
+        let mut i = match self.lookup.get(k) {
+            Some(&i) => i as usize,
+            None => last,
+        };
+        while i < last && self.nodes[i + 1].0 <= s {
+            i += 1;
+        }
+        while i > 0 && self.nodes[i].0 > s {
+            i -= 1;
+        }
+        i
     }
 
     /// Total length, m.
@@ -221,7 +248,7 @@ impl Alignment {
     /// both ends. The error is of order `h⁴·κ³/384`: below 1e-12 m for any railway curve.
     #[inline]
     pub fn position(&self, s: f64) -> (f64, f64) {
-        let i = self.nodes.partition_point(|n| n.0 <= s).max(1) - 1;
+        let i = self.node_index(s);
         if i + 1 >= self.nodes.len() {
             return self.position_exact(s);
         }
@@ -250,7 +277,7 @@ impl Alignment {
     /// Plane position by quadrature from the nearest node (the reference for
     /// [`Alignment::position`]).
     pub fn position_exact(&self, s: f64) -> (f64, f64) {
-        let i = self.nodes.partition_point(|n| n.0 <= s).max(1) - 1;
+        let i = self.node_index(s);
         let (sn, xn, yn) = self.nodes[i];
         if s <= sn {
             return (xn, yn);
@@ -281,4 +308,48 @@ fn integrate_piece(p: &Piece, a: f64, b: f64) -> (f64, f64) {
         let th = p.heading(mid + half * t);
         (x + w * half * th.cos(), y + w * half * th.sin())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The metre lookup finds the same node as a binary search over all nodes, on a track with
+    /// pieces of uneven length (nodes closer than 1 m) and off both ends.
+    #[test]
+    fn node_lookup_equals_binary_search() {
+        let mut start = 0.0;
+        let mut sections = Vec::new();
+        for (length, kind) in [
+            (10.3, SectionKind::Tangent),
+            (0.4, SectionKind::Transition),
+            (
+                37.7,
+                SectionKind::Curve {
+                    radius: 400.0,
+                    cant: 0.1,
+                    turn: Turn::Left,
+                },
+            ),
+            (2.05, SectionKind::Transition),
+            (5.0, SectionKind::Tangent),
+        ] {
+            sections.push(Section {
+                start,
+                length,
+                kind,
+            });
+            start += length;
+        }
+        let a = Alignment::new(&sections);
+        let mut s = -1.0;
+        while s < a.length() + 2.0 {
+            let expected = a.nodes.partition_point(|n| n.0 <= s).max(1) - 1;
+            assert_eq!(a.node_index(s), expected, "s = {s}");
+            s += 0.013;
+        }
+        for n in &a.nodes {
+            assert_eq!(a.nodes[a.node_index(n.0)].0, n.0);
+        }
+    }
 }

@@ -96,16 +96,29 @@ impl Element {
         };
         let (u, l) = (&bodies[upper.body].name, &bodies[lower.body].name);
         let side = if lower.local.y > 1e-3 { "l" } else { "r" };
-        let (stem, axes): (String, &[usize]) = match self {
-            Element::SpringNest(_) => (format!("nest_{l}"), &[2, 1]),
-            Element::ShearPad(_) => (format!("pad_{u}_{l}"), &[0, 1, 2]),
-            Element::SideBearer(_) => (format!("sidebearer_{l}_{side}"), &[2]),
-            Element::CentrePlate(_) => (format!("centreplate_{l}"), &[2]),
+        let stem = match self {
+            Element::SpringNest(_) => format!("nest_{l}"),
+            Element::ShearPad(_) => format!("pad_{u}_{l}"),
+            Element::SideBearer(_) => format!("sidebearer_{l}_{side}"),
+            Element::CentrePlate(_) => format!("centreplate_{l}"),
             _ => return Vec::new(),
         };
-        axes.iter()
+        self.gauge_axes()
+            .iter()
             .map(|&a| (format!("{stem}_{}", ["x", "y", "z"][a]), a))
             .collect()
+    }
+
+    /// The axes (0 x, 1 y, 2 z) of the deflection that [`Element::gauges`] records, in its
+    /// order; empty for elements without gauges. Allocation-free: the recorder calls it at
+    /// every step.
+    pub fn gauge_axes(&self) -> &'static [usize] {
+        match self {
+            Element::SpringNest(_) => &[2, 1],
+            Element::ShearPad(_) => &[0, 1, 2],
+            Element::SideBearer(_) | Element::CentrePlate(_) => &[2],
+            _ => &[],
+        }
     }
 
     fn attachments(&self) -> Option<(&Attachment, &Attachment)> {
