@@ -25,6 +25,7 @@ pub mod sensors;
 pub mod sim;
 pub mod track;
 pub mod vehicle;
+pub mod view;
 
 pub use error::{Error, Result};
 

@@ -183,8 +183,10 @@ pub fn demo(args: DemoArgs) -> Result<()> {
     eprintln!(
         "railforce demo: simulate 3 short conditions, train a CNN-BiLSTM and GBDT, sweep 2 SNRs, write the report"
     );
-    run_with(
-        &[Which::Paper],
-        &demo_options(super::builtin::resolve(&args.plan)?, args.out),
-    )
+    let opts = demo_options(super::builtin::resolve(&args.plan)?, args.out.clone());
+    run_with(&[Which::Paper], &opts)?;
+    super::view::write_demo_view(&args.out)?;
+    let index = experiment::write_report(&args.out)?;
+    println!("report with the viewer linked: {}", index.display());
+    Ok(())
 }

@@ -138,6 +138,12 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
                 n.reference.name()
             );
         }
+        if args.input.as_os_str() != "-" {
+            eprintln!(
+                "to see it over the true forces (for a run with all channels): {}",
+                super::view::hint(&args.input, Some(&args.out))
+            );
+        }
     }
     print_safety(&reports, &limits);
     Ok(())

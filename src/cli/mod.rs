@@ -13,6 +13,7 @@ mod simulate;
 mod track;
 mod train;
 mod validate;
+mod view;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -148,6 +149,18 @@ enum Command {
         after_help = "Examples:\n  railforce assess run.csv --track curve_r400\n  railforce assess identified.csv --out identified_assessment"
     )]
     Assess(assess::AssessArgs),
+    /// Replay a run in one self-contained HTML page for a class or a review: the leading
+    /// wheelset's wheels on their rails from the real profiles (contact points, two-point
+    /// contact, Y and Q arrows), a plan view of the wagon on the track (yaw and lateral shift
+    /// exaggerated, by factors the page states), and the label wheel's Y, Q and Y/Q with the
+    /// identified forces and the limits, all following a time slider with play and speed.
+    ///
+    /// The page needs no network (script and data inline) and opens from disk in any current
+    /// browser; a 60 s run makes about 3 MB at the default 100 frames per second.
+    #[command(
+        after_help = "Examples:\n  railforce simulate --track curve_r400 --duration 20 --out run.csv && railforce view run.csv\n  railforce view data/demo/curve_r400_v60_seed4.npz --identified identified.csv --out view.html"
+    )]
+    View(view::ViewArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
     /// `bench learn`).
     Bench(bench::BenchArgs),
@@ -198,6 +211,7 @@ pub fn main() -> ExitCode {
         Command::Demo(args) => experiment::demo(args),
         Command::Validate(args) => validate::run(args),
         Command::Assess(args) => assess::run(args),
+        Command::View(args) => view::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Init(args) => init(args),
     };

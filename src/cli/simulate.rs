@@ -122,5 +122,6 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         print!(" {} {:.1}", wheel_name(k), q * 1e-3);
     }
     println!();
+    println!("to watch it: {}", super::view::hint(&args.out, None));
     Ok(())
 }

@@ -263,6 +263,9 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
     }
 }
 
+/// Largest approach, either way, that [`height_for_load`] searches, m.
+const APPROACH_BRACKET: f64 = 0.02;
+
 /// The height of the wheelset centre above the rail at which this wheel carries the vertical
 /// load `load` (N) in the state `w` otherwise (bisection on the approach, the same
 /// evaluation as a run; damping plays no part when nothing moves).
@@ -278,10 +281,19 @@ pub fn height_for_load(
         v.height = ts.z - approach;
         evaluate(table, model, &v).force[2]
     };
+    // Bracket the approach: up from the rigid height, or down from it when the wheel already
+    // carries more (a roll beyond the table's presses one wheel in and lifts the other by up
+    // to a few millimetres).
     let (mut lo, mut hi) = (0.0, 1e-4);
-    while q(hi) < load && hi < super::elastic::STRIP_GAP_MAX {
+    while q(hi) < load && hi < APPROACH_BRACKET {
         lo = hi;
         hi *= 2.0;
+    }
+    let mut step = 1e-4;
+    while lo > -APPROACH_BRACKET && q(lo) > load {
+        hi = lo;
+        lo -= step;
+        step *= 2.0;
     }
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);

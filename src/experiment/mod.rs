@@ -365,6 +365,9 @@ fn read_log(dir: &Path) -> Vec<EpochLog> {
         .unwrap_or_default()
 }
 
+/// Folder of an experiments report that holds a viewer page (`railforce demo` writes one).
+pub const VIEW_FOLDER: &str = "view";
+
 /// Rebuilds `index.html` of an experiments folder from every part present (each part's
 /// `section.json` and `meta.json`), whichever order and run they came from; the intro states
 /// the protocol of the latest run and warns when parts were computed on different data.
@@ -429,11 +432,14 @@ pub fn write_report(out: &Path) -> Result<PathBuf> {
                 .join(", ")
         ));
     }
+    // After the parts, the viewer's folder where `railforce demo` wrote one.
+    let mut folders = Which::FOLDERS.to_vec();
+    folders.push(VIEW_FOLDER);
     write_index(
         out,
         "railforce: wheel–rail force identification experiments",
         &intro,
-        &Which::FOLDERS,
+        &folders,
     )?;
     Ok(out.join("index.html"))
 }

@@ -36,6 +36,9 @@ pub struct SavedSection {
     pub tables: Vec<(String, Table, String)>,
     /// Figures: caption, file name.
     pub figures: Vec<(String, String)>,
+    /// Links to pages beside the section (text, file name), such as the viewer.
+    #[serde(default)]
+    pub links: Vec<(String, String)>,
 }
 
 /// File that describes a section in its folder.
@@ -68,13 +71,20 @@ impl Section {
                 .iter()
                 .map(|(cap, _, name)| (cap.clone(), name.clone()))
                 .collect(),
+            links: Vec::new(),
         };
-        let json = serde_json::to_string_pretty(&saved).expect("section serialises");
-        crate::io::write_atomic(&dir.join(SECTION_FILE), |w| w.write_all(json.as_bytes()))
+        saved.write(dir)
     }
 }
 
 impl SavedSection {
+    /// Writes `dir/section.json` (the tables and figures it names are the caller's).
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        let json = serde_json::to_string_pretty(self).expect("section serialises");
+        crate::io::write_atomic(&dir.join(SECTION_FILE), |w| w.write_all(json.as_bytes()))
+    }
+
     /// Reads `dir/section.json`; `None` when the folder holds no section.
     pub fn read(dir: &Path) -> Result<Option<Self>> {
         let path = dir.join(SECTION_FILE);
@@ -107,6 +117,12 @@ impl SavedSection {
             s += &format!(
                 "<figure><img src=\"{prefix}{name}\" alt=\"{0}\"><figcaption>{0}</figcaption></figure>\n",
                 esc(cap)
+            );
+        }
+        for (text, name) in &self.links {
+            s += &format!(
+                "<p><a href=\"{prefix}{name}\"><strong>{}</strong></a></p>\n",
+                esc(text)
             );
         }
         s
