@@ -585,6 +585,7 @@ fn every_help_example_runs() {
         "evaluate",
         "identify",
         "assess",
+        "view",
         "validate",
         "experiment",
     ] {

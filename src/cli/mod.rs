@@ -158,7 +158,7 @@ enum Command {
     /// The page needs no network (script and data inline) and opens from disk in any current
     /// browser; a 60 s run makes about 3 MB at the default 100 frames per second.
     #[command(
-        after_help = "Examples:\n  railforce simulate --track curve_r400 --duration 20 --out run.csv && railforce view run.csv\n  railforce view data/demo/curve_r400_v60_seed4.npz --identified identified.csv --out view.html"
+        after_help = "Examples:\n  railforce view run.csv\n  (run.csv from: railforce simulate --track curve_r400 --duration 20 --out run.csv)\n  railforce view data/demo/curve_r400_v60_seed4.npz --identified identified.csv --out view.html"
     )]
     View(view::ViewArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
