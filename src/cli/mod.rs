@@ -6,6 +6,7 @@ mod bench;
 mod builtin;
 mod contact;
 mod experiment;
+mod export;
 mod generate;
 mod identify;
 mod select;
@@ -161,6 +162,14 @@ enum Command {
         after_help = "Examples:\n  railforce view run.csv\n  (run.csv from: railforce simulate --track curve_r400 --duration 20 --out run.csv)\n  railforce view data/demo/curve_r400_v60_seed4.npz --identified identified.csv --out view.html"
     )]
     View(view::ViewArgs),
+    /// Export a network's weights for Python: safetensors with the names and layouts of the
+    /// PyTorch module in assets/python/railforce_nets.py (the same layers), the inputs' and
+    /// targets' z-score statistics included, so the module reads physical inputs and returns
+    /// forces in N as `identify` does.
+    #[command(
+        after_help = "Examples:\n  railforce export --model models/demo\n  (then in Python: import railforce_nets; net = railforce_nets.load(\"models/demo/model.safetensors\"))"
+    )]
+    Export(export::ExportArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
     /// `bench learn`).
     Bench(bench::BenchArgs),
@@ -212,6 +221,7 @@ pub fn main() -> ExitCode {
         Command::Validate(args) => validate::run(args),
         Command::Assess(args) => assess::run(args),
         Command::View(args) => view::run(args),
+        Command::Export(args) => export::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Init(args) => init(args),
     };

@@ -3,6 +3,7 @@
 
 pub mod classical;
 pub mod evaluate;
+pub mod export;
 pub mod linalg;
 pub mod metrics;
 pub mod model;
