@@ -278,8 +278,20 @@ impl StripTable {
         let mut j0 = w0.first.max(w1.first);
         let mut j1 = (w0.first + w0.len).min(w1.first + w1.len);
         // Strips outside both narrow windows have gaps above NARROW_GAP at both ends of the
-        // interval: while the deepest possible penetration stays below that, skip them.
-        if approach + roll.abs() * 0.9 < NARROW_GAP {
+        // interval: while the deepest possible penetration stays below that, skip them. The
+        // penetration less the gap, `approach − roll·y`, is linear in y, and y runs
+        // monotonically along the window: its largest value is at one of the window's ends.
+        let y_at = |j: u32| {
+            let ya = self.gap_y[(w0.offset + j - w0.first) as usize][1];
+            let yb = self.gap_y[(w1.offset + j - w1.first) as usize][1];
+            ya + t * (yb - ya)
+        };
+        let deepest = if j1 > j0 {
+            (approach - roll * y_at(j0)).max(approach - roll * y_at(j1 - 1))
+        } else {
+            approach
+        };
+        if deepest < NARROW_GAP {
             j0 = j0.max(w0.narrow.0.min(w1.narrow.0));
             j1 = j1.min(w0.narrow.1.max(w1.narrow.1));
         }
