@@ -157,7 +157,7 @@ enum Command {
     /// identified forces and the limits, all following a time slider with play and speed.
     ///
     /// The page needs no network (script and data inline) and opens from disk in any current
-    /// browser; a 60 s run makes about 3 MB at the default 100 frames per second.
+    /// browser; a 60 s run makes 1.8 MB at the default 100 frames per second.
     #[command(
         after_help = "Examples:\n  railforce view run.csv\n  (run.csv from: railforce simulate --track curve_r400 --duration 20 --out run.csv)\n  railforce view data/demo/curve_r400_v60_seed4.npz --identified identified.csv --out view.html"
     )]
