@@ -340,6 +340,10 @@ fn built_in_vehicles_and_tracks_work_from_an_empty_folder() {
     // A bare name stands for a built-in track, vehicle or plan.
     let (ok, out, err) = run(&["track", "curve_r400"]);
     assert!(ok && out.contains("R 400 m"), "{out}\n{err}");
+    // …also beside a folder of that name (`railforce demo` writes `demo/`).
+    std::fs::create_dir_all(dir.join("curve_r400")).unwrap();
+    let (ok, out, err) = run(&["track", "curve_r400"]);
+    assert!(ok && out.contains("R 400 m"), "{out}\n{err}");
     let (ok, out, err) = run(&["init", "mine"]);
     assert!(ok, "{err}");
     assert!(out.contains("wrote"), "{out}");

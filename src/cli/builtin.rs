@@ -144,7 +144,9 @@ pub const FILES: &[(&str, &str)] = &[
 /// The path to read for `path`: itself when it exists, else the built-in copy of the same
 /// file when there is one, else itself (the loader then says it is missing).
 pub fn resolve(path: &Path) -> Result<PathBuf> {
-    if path.exists() {
+    // A folder never stands for a file: `railforce demo` writes `demo/`, and `--plan demo`
+    // run beside it still means the built-in plan.
+    if path.exists() && !path.is_dir() {
         return Ok(path.to_path_buf());
     }
     let rel = path.strip_prefix("./").unwrap_or(path);
