@@ -1,5 +1,7 @@
 //! The command line as a user runs it.
 
+mod common;
+
 use std::process::Command;
 
 fn railforce(args: &[&str]) -> (bool, String, String) {
@@ -370,16 +372,7 @@ fn demo_runs_from_an_empty_folder() {
     let dir = std::env::temp_dir().join(format!("railforce-demo-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
-        .arg("demo")
-        .current_dir(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::succeed(common::railforce_in(&dir).arg("demo"));
     // Every link of the report resolves.
     let html = std::fs::read_to_string(dir.join("demo/index.html")).unwrap();
     let mut links = 0;

@@ -1,5 +1,7 @@
 //! Data set generation: formats, resume, shards, noise, and loading from Python.
 
+mod common;
+
 use railforce::dataset::{self, Event, Format, GenerateOptions, npz};
 use railforce::plan::Plan;
 use railforce::sensors::{NoiseModel, SnrReference};
@@ -179,16 +181,7 @@ fn generate_resume_shard_merge_and_formats() {
 }
 
 fn python_loads(npz_file: &Path, parquet_file: &Path, n_channels: usize) {
-    let required = std::env::var_os("RAILFORCE_PYTHON_TESTS").is_some();
-    let check = std::process::Command::new("python3")
-        .args(["-c", "import numpy, pyarrow"])
-        .output();
-    if !matches!(&check, Ok(o) if o.status.success()) {
-        assert!(
-            !required,
-            "python3 with numpy and pyarrow is required (RAILFORCE_PYTHON_TESTS is set)"
-        );
-        eprintln!("skipping the Python check: no python3 with numpy and pyarrow");
+    if !common::python_with("numpy, pyarrow") {
         return;
     }
     let script = [
@@ -205,15 +198,7 @@ fn python_loads(npz_file: &Path, parquet_file: &Path, n_channels: usize) {
         "print('ok')".into(),
     ]
     .join("\n");
-    let out = std::process::Command::new("python3")
-        .args(["-c", &script])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::succeed(std::process::Command::new("python3").args(["-c", &script]));
 }
 
 #[test]
@@ -387,24 +372,12 @@ fn float32_subset_keeps_values_to_float32_precision() {
     }
     let size = |d: &Path| std::fs::metadata(d.join("t_seed1.npz")).unwrap().len();
     assert!(size(&b) < size(&a) / 2, "{} vs {}", size(&b), size(&a));
-    if std::process::Command::new("python3")
-        .args(["-c", "import numpy"])
-        .output()
-        .is_ok_and(|o| o.status.success())
-    {
+    if common::python_with("numpy") {
         let script = format!(
             "import numpy as np\nd = np.load(r'{}')\nassert d['w1l_force_z'].dtype == np.float32\nassert d['time_s'].dtype == np.float64\nprint('ok')",
             b.join("t_seed1.npz").display()
         );
-        let out = std::process::Command::new("python3")
-            .args(["-c", &script])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        common::succeed(std::process::Command::new("python3").args(["-c", &script]));
     }
     // The folder now holds a float32 data set: the float64 plan is refused there.
     let err = dataset::generate(

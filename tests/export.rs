@@ -2,6 +2,8 @@
 //! alone (assets/python/numpy_forward.py, PyTorch's names and layouts), gives the forces
 //! `railforce identify` gives.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -16,16 +18,7 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn railforce(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_railforce"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "railforce {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::succeed(common::railforce_in(root()).args(args));
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
@@ -157,16 +150,7 @@ fn tiny_data() -> PathBuf {
 /// tests/identify.rs). CI requires numpy (RAILFORCE_PYTHON_TESTS=1).
 #[test]
 fn numpy_forward_of_the_export_equals_identify_for_all_four_networks() {
-    let required = std::env::var_os("RAILFORCE_PYTHON_TESTS").is_some();
-    let check = Command::new("python3")
-        .args(["-c", "import numpy"])
-        .output();
-    if !matches!(&check, Ok(o) if o.status.success()) {
-        assert!(
-            !required,
-            "python3 with numpy is required (RAILFORCE_PYTHON_TESTS is set)"
-        );
-        eprintln!("skipping the numpy check: no python3 with numpy");
+    if !common::python_with("numpy") {
         return;
     }
     let data = tiny_data();
@@ -203,17 +187,12 @@ fn numpy_forward_of_the_export_equals_identify_for_all_four_networks() {
             ours.to_str().unwrap(),
         ]);
         let theirs = tmp(&format!("{arch}_numpy.csv"));
-        let out = Command::new("python3")
-            .arg(root().join("assets/python/numpy_forward.py"))
-            .arg(model.join("model.safetensors"))
-            .arg(&run)
-            .arg(&theirs)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        common::succeed(
+            Command::new("python3")
+                .arg(root().join("assets/python/numpy_forward.py"))
+                .arg(model.join("model.safetensors"))
+                .arg(&run)
+                .arg(&theirs),
         );
         let (h1, a) = read_csv(&ours);
         let (h2, b) = read_csv(&theirs);

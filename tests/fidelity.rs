@@ -2,6 +2,8 @@
 //! evaluation (continuous, and the same in a run and in `railforce contact`), and (ignored,
 //! release) the simulator's fidelity checks.
 
+mod common;
+
 use railforce::contact::{Side, WheelOnRail, evaluate, height_for_load};
 use railforce::sim::{SimConfig, Simulation, fidelity};
 use railforce::vehicle::Vehicle;
@@ -200,25 +202,20 @@ fn run_cli_and_library_compute_the_same_contact() {
     // The CLI: a wheelset at 4 mm, 122.6 kN, 60 km/h, rolling at the nominal radius (given:
     // the CLI's default spin rolls at the actual radii of the shift).
     let spin = (60.0 / 3.6 / v.contact.geometry.nominal_radius).to_string();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
-        .args(["contact", "--vehicle"])
-        .arg(root().join("vehicles/c80.toml"))
-        .args([
-            "--y-mm",
-            "4",
-            "--load-kn",
-            "122.6",
-            "--speed-kmh",
-            "60",
-            "--spin",
-            &spin,
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = common::succeed(
+        std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .args(["contact", "--vehicle"])
+            .arg(root().join("vehicles/c80.toml"))
+            .args([
+                "--y-mm",
+                "4",
+                "--load-kn",
+                "122.6",
+                "--speed-kmh",
+                "60",
+                "--spin",
+                &spin,
+            ]),
     );
     let text = String::from_utf8_lossy(&out.stdout);
     let line = text

@@ -4,6 +4,8 @@
 //! a value or an error that names the file; a panic fails the test. A bounded number of cases
 //! per file (seeded, so a failure reproduces).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 const CASES: usize = 40;
@@ -280,15 +282,7 @@ fn model_and_data_set_files_parse_or_say_why() {
     )
     .unwrap();
     let run = |args: &[&str]| {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
-            .args(args)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        common::succeed(std::process::Command::new(env!("CARGO_BIN_EXE_railforce")).args(args));
     };
     let data = dir.join("data");
     let model = dir.join("model");

@@ -2,6 +2,8 @@
 //! RAILFORCE_PYTHON_TESTS=1 and scikit-learn installed): SVR, GBDT and the decision tree must
 //! score within 0.03 test R² of scikit-learn's with the same settings.
 
+mod common;
+
 use railforce::learn::classical::{Classical, ClassicalParams};
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -51,16 +53,7 @@ fn r2(y: &[f32], p: &[f32]) -> f64 {
 
 #[test]
 fn classical_models_match_scikit_learn() {
-    let required = std::env::var_os("RAILFORCE_PYTHON_TESTS").is_some();
-    let probe = Command::new("python3")
-        .args(["-c", "import sklearn, numpy"])
-        .status();
-    if !probe.is_ok_and(|s| s.success()) {
-        assert!(
-            !required,
-            "python3 with scikit-learn is required (RAILFORCE_PYTHON_TESTS is set)"
-        );
-        eprintln!("skipped: python3 with scikit-learn not found");
+    if !common::python_with("sklearn, numpy") {
         return;
     }
     let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -76,16 +69,7 @@ fn classical_models_match_scikit_learn() {
         env!("CARGO_MANIFEST_DIR"),
         "/assets/analysis/sklearn_check.py"
     );
-    let out = Command::new("python3")
-        .arg(script)
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::succeed(Command::new("python3").arg(script).arg(&dir));
     let sk: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let mut failures = Vec::new();
     for (name, params) in [

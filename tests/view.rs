@@ -1,6 +1,8 @@
 //! The viewer: the scene a page draws, the page itself, and (release, CI) the page in a real
 //! browser.
 
+mod common;
+
 use railforce::sim::{SimConfig, Simulation, output};
 use railforce::track::{Track, TrackSpec};
 use railforce::vehicle::Vehicle;
@@ -210,9 +212,7 @@ fn the_page_draws_in_a_real_browser() {
     let run = tmp("curve.csv");
     let bin = env!("CARGO_BIN_EXE_railforce");
     let ok = |c: &mut Command| {
-        let o = c.current_dir(root()).output().unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        String::from_utf8_lossy(&o.stdout).into_owned()
+        String::from_utf8_lossy(&common::succeed(c.current_dir(root())).stdout).into_owned()
     };
     let said = ok(Command::new(bin).args([
         "simulate",
