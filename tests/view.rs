@@ -123,6 +123,25 @@ fn the_scene_reproduces_the_recorded_loads_and_the_page_is_self_contained() {
     }
     assert!(id.q.iter().all(|q| q.is_nan()), "Q was not identified");
     assert!(scene.bodies.iter().any(|b| b.kind == "sideframe"));
+    // An identified file that is not identify's output is named, with what to give.
+    let err = Scene::build(
+        "test run",
+        &cols,
+        &Inputs {
+            vehicle: &v,
+            track: &track,
+            identified: Some(("not_identified.csv".into(), vec![("a".into(), vec![1.0])])),
+            limits: limits(),
+            rate_hz: 100.0,
+            speed_kmh: None,
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("not_identified.csv") && err.contains("railforce identify"),
+        "{err}"
+    );
     let html = page::html(&scene).unwrap();
     for external in ["http://", "https://", "src=\"", "<link"] {
         assert!(

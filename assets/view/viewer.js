@@ -180,17 +180,29 @@
   }
 
   // ---- traces of the label wheel with the cursor ----
-  function drawTraces() {
-    const [c, g] = ctx2d("traces");
+  // The traces are drawn once into an off-screen canvas; each frame copies it and adds the
+  // cursor and the values (smooth playback of long runs on a modest laptop).
+  let traceCache = null;
+  function traceLayout(c) {
+    const left = 70, right = c.width - 15, ph = (c.height - 40) / 3, t0 = S.time[0], t1 = S.time[N - 1];
+    const X = (t) => left + (t - t0) / Math.max(1e-9, t1 - t0) * (right - left);
+    return { left, right, ph, t0, t1, X };
+  }
+  function tracePlots() {
     const T = S.traces, I = S.identified, Lm = S.limits;
-    const plots = [
+    return [
       { name: "Y (kN)", t: T.y, i: I && I.y, lim: [] },
       { name: "Q (kN)", t: T.q, i: I && I.q, lim: [[Lm.q_min, "Q min (unloading " + Lm.q_min.toFixed(0) + " kN)"], [Lm.q_static, "static Q̄"]] },
       { name: "|Y|/Q", t: T.y_over_q, i: I && I.y_over_q, lim: [[Lm.y_over_q, "limit " + Lm.y_over_q]] },
     ];
-    const left = 70, right = c.width - 15, ph = (c.height - 40) / 3, t0 = S.time[0], t1 = S.time[N - 1];
-    const X = (t) => left + (t - t0) / Math.max(1e-9, t1 - t0) * (right - left);
-    plots.forEach((p, k) => {
+  }
+  function drawTraceLines(c) {
+    const off = document.createElement("canvas");
+    off.width = c.width; off.height = c.height;
+    const g = off.getContext("2d");
+    g.font = "14px system-ui, sans-serif";
+    const { left, right, ph, t0, t1, X } = traceLayout(c);
+    tracePlots().forEach((p, k) => {
       const top = 10 + k * ph, bot = top + ph - 22;
       const vals = p.t.concat(p.i || [], p.lim.map((l) => l[0])).filter((v) => v !== null && isFinite(v));
       let lo = Math.min(...vals), hi = Math.max(...vals);
@@ -211,11 +223,22 @@
       };
       line(p.t, COL.truth, []);
       if (p.i) line(p.i, COL.ident, [5, 3]);
+    });
+    g.fillStyle = COL.soft; g.fillText(t0.toFixed(1) + " s", left, c.height - 8); g.fillText(t1.toFixed(1) + " s", right - 50, c.height - 8);
+    return off;
+  }
+  function drawTraces() {
+    const [c, g] = ctx2d("traces");
+    if (!traceCache) traceCache = drawTraceLines(c);
+    g.drawImage(traceCache, 0, 0);
+    const I = S.identified, Lm = S.limits;
+    const { left, ph, X } = traceLayout(c);
+    tracePlots().forEach((p, k) => {
+      const top = 10 + k * ph;
       const tv = p.t[frame], iv = p.i ? p.i[frame] : null;
       g.fillStyle = COL.truth; g.fillText("true " + fmt(tv, 2), left + 8, top + 16);
       if (p.i) { g.fillStyle = COL.ident; g.fillText("identified " + fmt(iv, 2), left + 120, top + 16); }
     });
-    g.fillStyle = COL.soft; g.fillText(t0.toFixed(1) + " s", left, c.height - 8); g.fillText(t1.toFixed(1) + " s", right - 50, c.height - 8);
     const x = X(S.time[frame]);
     g.strokeStyle = COL.ink; g.lineWidth = 2; g.beginPath(); g.moveTo(x, 6); g.lineTo(x, c.height - 28); g.stroke();
     $("trace-title").textContent = "Forces of the label wheel " + S.label + (I ? ": true (blue) and identified (orange, dashed)" : ": true");

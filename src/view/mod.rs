@@ -290,7 +290,15 @@ impl Scene {
         };
         let (identified, identified_source) = match &inp.identified {
             Some((src, id)) => {
-                let t_id = column(src, id, "time_s")?;
+                let t_id = id
+                    .iter()
+                    .find(|(n, _)| n == "time_s")
+                    .map(|(_, v)| v.as_slice())
+                    .ok_or_else(|| {
+                        Error::Domain(format!(
+                            "{src}: no time_s column: --identified takes the output of `railforce identify`"
+                        ))
+                    })?;
                 let find = |comp: char| {
                     let name = format!("w{label_key}_force_{comp}");
                     id.iter()
