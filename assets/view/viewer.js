@@ -111,6 +111,28 @@
       "Wheelset shift is relative to each rail (irregularity removed); roll " + fmt(S.wheels[0].roll[frame], 2) + " mrad.";
   }
 
+  // ---- the whole wheelset, schematic: shift and roll exaggerated so a class can see them ----
+  const AXLE_SHIFT = 5, AXLE_ROLL = 20;
+  function drawAxle() {
+    const [c, g] = ctx2d("axle");
+    const k = 0.55, cx = c.width / 2, base = 70; // px per mm at the rail tops
+    const ws = S.bodies.find((b) => b.kind === "wheelset");
+    const y = ws ? ws.y[frame] : 0.5 * (S.wheels[0].y[frame] + S.wheels[1].y[frame]);
+    const phi = S.wheels[0].roll[frame] / 1000 * AXLE_ROLL;
+    const hg = S.profiles.half_gauge, r = 22; // wheel drawn 44 px high
+    g.fillStyle = COL.rail;
+    for (const s of [1, -1]) g.fillRect(cx - (s * (hg + 35)) * k - 36 * k, base, 72 * k, 14);
+    g.strokeStyle = COL.grid; g.setLineDash([4, 4]); g.beginPath(); g.moveTo(cx, 4); g.lineTo(cx, c.height - 4); g.stroke(); g.setLineDash([]);
+    g.save(); g.translate(cx - y * AXLE_SHIFT * k, base - r); g.rotate(phi);
+    g.strokeStyle = COL.ink; g.lineWidth = 5; g.beginPath(); g.moveTo(-(hg + 70) * k, 0); g.lineTo((hg + 70) * k, 0); g.stroke();
+    g.fillStyle = COL.wheel; g.strokeStyle = COL.ink; g.lineWidth = 1.5;
+    for (const s of [1, -1]) { const xw = -s * (hg + 35) * k; g.fillRect(xw - 40 * k, -r, 80 * k, 2 * r); g.strokeRect(xw - 40 * k, -r, 80 * k, 2 * r); }
+    g.restore();
+    g.fillStyle = COL.ink; g.font = "13px system-ui, sans-serif";
+    g.fillText("whole wheelset, schematic: shift ×" + AXLE_SHIFT + " (" + fmt(y, 1) + " mm from the track centre), roll ×" + AXLE_ROLL + " (" + fmt(S.wheels[0].roll[frame], 2) + " mrad)", 8, 16);
+    g.fillText("left", 8, base + 12); g.fillText("right", c.width - 40, base + 12);
+  }
+
   // ---- plan view: track map above, the wagon in the track's (unrolled) frame below ----
   function drawPlan() {
     const [c, g] = ctx2d("plan");
@@ -248,7 +270,7 @@
   function draw() {
     slider.value = String(frame);
     clock.textContent = "t = " + S.time[frame].toFixed(2) + " s   s = " + S.s[frame].toFixed(1) + " m   frame " + (frame + 1) + " / " + N;
-    drawCross(); drawPlan(); drawTraces();
+    drawAxle(); drawCross(); drawPlan(); drawTraces();
     document.body.dataset.frame = String(frame);
     if (!document.body.dataset.status) document.body.dataset.status = "ok";
   }
@@ -291,7 +313,7 @@
         }
       return (n / Math.max(1, all)).toFixed(4);
     };
-    const regions = { cross_left: ["cross", 0, 0, 0.5, 1], cross_right: ["cross", 0.5, 0, 1, 1],
+    const regions = { axle: ["axle", 0, 0.25, 1, 1], cross_left: ["cross", 0, 0, 0.5, 1], cross_right: ["cross", 0.5, 0, 1, 1],
       plan_map: ["plan", 0, 0.05, 0.3, 0.24], plan_wagon: ["plan", 0, 0.26, 1, 1],
       trace_y: ["traces", 0.07, 0, 1, 0.33], trace_q: ["traces", 0.07, 0.33, 1, 0.66],
       trace_yq: ["traces", 0.07, 0.66, 1, 0.95] };
