@@ -581,6 +581,7 @@ fn every_help_example_runs() {
         "train",
         "evaluate",
         "identify",
+        "export",
         "assess",
         "view",
         "validate",
