@@ -32,11 +32,7 @@ pub struct AssessArgs {
 
 /// The track a data set's manifest records for the run file `file`, if any.
 fn track_from_manifest(file: &Path) -> Option<PathBuf> {
-    let dir = file.parent()?;
-    let text = std::fs::read_to_string(dir.join("manifest.json")).ok()?;
-    let m: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let name = file.file_name()?.to_str()?;
-    let run = m["runs"].as_array()?.iter().find(|r| r["file"] == name)?;
+    let (_, run) = railforce::dataset::run_entry(file)?;
     let p = PathBuf::from(run["track"]["file"].as_str()?);
     p.exists().then_some(p)
 }

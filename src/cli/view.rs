@@ -68,16 +68,8 @@ fn run_meta(run: &Path) -> RunMeta {
             speed_kmh: m["speed_kmh"].as_f64(),
         };
     }
-    let dir = run.parent().unwrap_or(Path::new("."));
-    let Some(m) = read_json(&dir.join("manifest.json")) else {
-        return RunMeta::default();
-    };
-    let name = run.file_name().map(|n| n.to_string_lossy().into_owned());
-    let entry = m["runs"]
-        .as_array()
-        .and_then(|runs| runs.iter().find(|r| r["file"].as_str() == name.as_deref()));
-    match entry {
-        Some(r) => RunMeta {
+    match railforce::dataset::run_entry(run) {
+        Some((m, r)) => RunMeta {
             vehicle: path_of(&m["vehicle"]),
             track: path_of(&r["track"]),
             seed: r["seed"].as_u64(),

@@ -176,6 +176,21 @@ pub(super) fn refuse_mixing(
     )))
 }
 
+/// The manifest of the data set a run file belongs to (`manifest.json` beside it) and the
+/// run's entry in it, when the file is listed there.
+pub fn run_entry(run_file: &Path) -> Option<(Value, Value)> {
+    let dir = run_file.parent().unwrap_or(Path::new("."));
+    let text = std::fs::read_to_string(dir.join("manifest.json")).ok()?;
+    let m: Value = serde_json::from_str(&text).ok()?;
+    let name = run_file.file_name()?.to_str()?;
+    let entry = m["runs"]
+        .as_array()?
+        .iter()
+        .find(|r| r["file"] == name)?
+        .clone();
+    Some((m, entry))
+}
+
 /// Joins the shard manifests in `out` into `manifest.json` (runs sorted by condition and seed).
 pub fn merge(out: &Path) -> Result<Value> {
     let mut shards: Vec<PathBuf> = std::fs::read_dir(out)

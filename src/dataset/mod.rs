@@ -8,7 +8,7 @@ mod manifest;
 pub mod npz;
 pub mod parquet_file;
 
-pub use manifest::{data_identity, file_hash, fnv1a, manifest_path, merge};
+pub use manifest::{data_identity, file_hash, fnv1a, manifest_path, merge, run_entry};
 use manifest::{read_manifest, refuse_mixing, run_key, sort_runs, write_manifest};
 
 use crate::error::{Error, Result};

@@ -39,7 +39,16 @@ fn columns(w: &[f32], rows: usize, cols: usize, from: usize, to: usize) -> Vec<f
         .collect()
 }
 
-/// The PyTorch state dict of a network model, in the module's names.
+fn tensor(name: impl Into<String>, shape: Vec<usize>, data: Vec<f32>) -> Tensor {
+    Tensor {
+        name: name.into(),
+        shape,
+        data,
+    }
+}
+
+/// The PyTorch state dict of a network model, in the module's names: dense layers first,
+/// then batch norms, the recurrent layer and the z-score buffers.
 fn tensors(model: &Model) -> Result<Vec<Tensor>> {
     let Engine::Net(net) = &model.engine else {
         return Err(Error::Domain(format!(
@@ -56,16 +65,21 @@ fn tensors(model: &Model) -> Result<Vec<Tensor>> {
             .ok_or_else(|| Error::Domain(format!("the network has no tensor '{name}'")))?;
         Ok((&p.value[s.range()], &s.shape))
     };
+    let arch = net.config.architecture;
+    let stem = matches!(arch, Architecture::CnnBiLstm | Architecture::Cnn);
     let mut out = Vec::new();
-    let mut push = |name: &str, shape: Vec<usize>, data: Vec<f32>| {
-        out.push(Tensor {
-            name: name.into(),
-            shape,
-            data,
-        })
-    };
     // Dense layers: ours `[in, out]`, PyTorch `[out, in]` (`[out, in, 1]` for a Conv1d).
-    let mut dense = |ours: &str, theirs: &str, conv: bool| -> Result<()> {
+    let convs: &[(&str, &str, bool)] = if stem {
+        &[("conv1", "conv1", true), ("conv2", "conv2", true)]
+    } else {
+        &[]
+    };
+    let heads = [
+        ("head.fc1", "fc1", false),
+        ("head.fc2", "fc2", false),
+        ("head.out", "out", false),
+    ];
+    for &(ours, theirs, conv) in convs.iter().chain(&heads) {
         let (w, shape) = get(&format!("{ours}.weight"))?;
         let (din, dout) = (shape[0], shape[1]);
         let shape = if conv {
@@ -73,30 +87,19 @@ fn tensors(model: &Model) -> Result<Vec<Tensor>> {
         } else {
             vec![dout, din]
         };
-        push(&format!("{theirs}.weight"), shape, transpose(w, din, dout));
-        push(
-            &format!("{theirs}.bias"),
-            vec![dout],
-            get(&format!("{ours}.bias"))?.0.to_vec(),
-        );
-        Ok(())
-    };
-    let arch = net.config.architecture;
-    if matches!(arch, Architecture::CnnBiLstm | Architecture::Cnn) {
-        dense("conv1", "conv1", true)?;
-        dense("conv2", "conv2", true)?;
+        out.push(tensor(
+            format!("{theirs}.weight"),
+            shape,
+            transpose(w, din, dout),
+        ));
+        let bias = get(&format!("{ours}.bias"))?.0.to_vec();
+        out.push(tensor(format!("{theirs}.bias"), vec![dout], bias));
     }
-    dense("head.fc1", "fc1", false)?;
-    dense("head.fc2", "fc2", false)?;
-    dense("head.out", "out", false)?;
-    let mut rest: Vec<Tensor> = Vec::new();
-    let mut put =
-        |name: String, shape: Vec<usize>, data: Vec<f32>| rest.push(Tensor { name, shape, data });
-    if matches!(arch, Architecture::CnnBiLstm | Architecture::Cnn) {
+    if stem {
         for bn in ["bn1", "bn2"] {
             for part in ["weight", "bias", "running_mean", "running_var"] {
                 let (v, shape) = get(&format!("{bn}.{part}"))?;
-                put(format!("{bn}.{part}"), shape.to_vec(), v.to_vec());
+                out.push(tensor(format!("{bn}.{part}"), shape.to_vec(), v.to_vec()));
             }
         }
     }
@@ -110,28 +113,31 @@ fn tensors(model: &Model) -> Result<Vec<Tensor>> {
             let (b_ih, _) = get("bilstm.b_ih")?;
             let (b_hh, _) = get("bilstm.b_hh")?;
             for (dir, suffix) in [(0, ""), (1, "_reverse")] {
-                let wi = columns(w_ih, din, g8, dir * g4, (dir + 1) * g4);
-                put(
-                    format!("lstm.weight_ih_l0{suffix}"),
-                    vec![g4, din],
-                    transpose(&wi, din, g4),
-                );
+                let gates = dir * g4..(dir + 1) * g4;
+                let wi = columns(w_ih, din, g8, gates.start, gates.end);
                 let wh = &w_hh[dir * h * g4..(dir + 1) * h * g4];
-                put(
-                    format!("lstm.weight_hh_l0{suffix}"),
-                    vec![g4, h],
-                    transpose(wh, h, g4),
-                );
-                put(
-                    format!("lstm.bias_ih_l0{suffix}"),
-                    vec![g4],
-                    b_ih[dir * g4..(dir + 1) * g4].to_vec(),
-                );
-                put(
-                    format!("lstm.bias_hh_l0{suffix}"),
-                    vec![g4],
-                    b_hh[dir * g4..(dir + 1) * g4].to_vec(),
-                );
+                out.extend([
+                    tensor(
+                        format!("lstm.weight_ih_l0{suffix}"),
+                        vec![g4, din],
+                        transpose(&wi, din, g4),
+                    ),
+                    tensor(
+                        format!("lstm.weight_hh_l0{suffix}"),
+                        vec![g4, h],
+                        transpose(wh, h, g4),
+                    ),
+                    tensor(
+                        format!("lstm.bias_ih_l0{suffix}"),
+                        vec![g4],
+                        b_ih[gates.clone()].to_vec(),
+                    ),
+                    tensor(
+                        format!("lstm.bias_hh_l0{suffix}"),
+                        vec![g4],
+                        b_hh[gates].to_vec(),
+                    ),
+                ]);
             }
         }
         Architecture::Gru => {
@@ -139,52 +145,22 @@ fn tensors(model: &Model) -> Result<Vec<Tensor>> {
             let (din, g3) = (s[0], s[1]);
             let (w_hh, s) = get("gru.w_hh")?;
             let h = s[0];
-            put(
-                "gru.weight_ih_l0".into(),
-                vec![g3, din],
-                transpose(w_ih, din, g3),
-            );
-            put(
-                "gru.weight_hh_l0".into(),
-                vec![g3, h],
-                transpose(w_hh, h, g3),
-            );
-            put(
-                "gru.bias_ih_l0".into(),
-                vec![g3],
-                get("gru.b_ih")?.0.to_vec(),
-            );
-            put(
-                "gru.bias_hh_l0".into(),
-                vec![g3],
-                get("gru.b_hh")?.0.to_vec(),
-            );
+            out.extend([
+                tensor("gru.weight_ih_l0", vec![g3, din], transpose(w_ih, din, g3)),
+                tensor("gru.weight_hh_l0", vec![g3, h], transpose(w_hh, h, g3)),
+                tensor("gru.bias_ih_l0", vec![g3], get("gru.b_ih")?.0.to_vec()),
+                tensor("gru.bias_hh_l0", vec![g3], get("gru.b_hh")?.0.to_vec()),
+            ]);
         }
         Architecture::Cnn => {}
     }
     let m = &model.meta;
-    let f = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
-    put(
-        "input_mean".into(),
-        vec![m.input_stats.mean.len()],
-        f(&m.input_stats.mean),
-    );
-    put(
-        "input_std".into(),
-        vec![m.input_stats.std.len()],
-        f(&m.input_stats.std),
-    );
-    put(
-        "target_mean".into(),
-        vec![m.target_stats.mean.len()],
-        f(&m.target_stats.mean),
-    );
-    put(
-        "target_std".into(),
-        vec![m.target_stats.std.len()],
-        f(&m.target_stats.std),
-    );
-    out.extend(rest);
+    for (which, stats) in [("input", &m.input_stats), ("target", &m.target_stats)] {
+        for (part, v) in [("mean", &stats.mean), ("std", &stats.std)] {
+            let data: Vec<f32> = v.iter().map(|&x| x as f32).collect();
+            out.push(tensor(format!("{which}_{part}"), vec![data.len()], data));
+        }
+    }
     Ok(out)
 }
 
