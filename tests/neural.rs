@@ -163,3 +163,162 @@ fn fused_evaluation_matches_the_layer_by_layer_path() {
         }
     }
 }
+
+/// The hand-written engine against burn's autodiff (`cargo test --features burn`): the same
+/// network as burn modules, the same weights, inputs and dropout masks.
+#[cfg(feature = "burn")]
+mod against_burn {
+    use super::{config, data};
+    use burn::tensor::Device;
+    use railforce::learn::burn::BurnNet;
+    use railforce::learn::neural::{Adam, Architecture, Network};
+
+    const ALL: [Architecture; 4] = [
+        Architecture::CnnBiLstm,
+        Architecture::Cnn,
+        Architecture::BiLstm,
+        Architecture::Gru,
+    ];
+
+    /// A network with every weight random, batch-norm scales and shifts away from 1 and 0,
+    /// and running statistics away from their initial values.
+    fn random_net(arch: Architecture, c: usize, o: usize) -> Network {
+        let mut net = Network::new(config(arch, c, o, 0.2));
+        for slot in net.params.slots.clone() {
+            let bn = slot.name.starts_with("bn");
+            for (k, i) in slot.range().enumerate() {
+                let wobble = ((k as f32 + 1.0) * 0.917).sin();
+                if slot.name.ends_with(".weight") && bn || slot.name.ends_with("running_var") {
+                    net.params.value[i] = 1.0 + 0.3 * wobble;
+                } else if bn {
+                    net.params.value[i] = 0.2 * wobble;
+                }
+            }
+        }
+        net
+    }
+
+    /// `max |a − b| ≤ tol · max(max |a|, floor)` per slot; returns the worst relative error.
+    fn compare(what: &str, net: &Network, a: &[f32], b: &[f32], tol: f32, floor: f32) -> f32 {
+        let mut worst = 0.0f32;
+        for slot in &net.params.slots {
+            let r = slot.range();
+            let scale = a[r.clone()].iter().fold(floor, |m, v| m.max(v.abs()));
+            let err = a[r.clone()]
+                .iter()
+                .zip(&b[r])
+                .fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
+            assert!(
+                err <= tol * scale,
+                "{what} of {}: engine and burn differ by {err} (scale {scale})",
+                slot.name
+            );
+            worst = worst.max(err / scale);
+        }
+        worst
+    }
+
+    #[test]
+    fn every_weight_gradient_equals_burns_autodiff() {
+        let device = Device::flex();
+        for arch in ALL {
+            let (batch, c, o) = (7, 5, 2);
+            let mut net = random_net(arch, c, o);
+            let (x, y) = data(batch, c, o);
+            let before = net.params.value.clone();
+            // The engine: training forward (dropout on, batch statistics), backward of the MSE.
+            net.reseed_dropout(42);
+            net.params.zero_grad();
+            let pred = net.forward(&x, batch, true).to_vec();
+            let n = y.len() as f32;
+            let dout: Vec<f32> = pred.iter().zip(&y).map(|(p, t)| 2.0 * (p - t) / n).collect();
+            let loss: f64 = pred
+                .iter()
+                .zip(&y)
+                .map(|(p, t)| f64::from(p - t).powi(2))
+                .sum::<f64>()
+                / f64::from(n);
+            net.backward(&x, &dout);
+            let engine_grad = net.params.grad.clone();
+            let engine_stats = net.params.value.clone();
+            // burn: the same weights and the same dropout masks.
+            net.params.value = before;
+            net.reseed_dropout(42);
+            let mut module = BurnNet::new(&net.config, &device);
+            let step = module.gradients(&mut net, &x, &y, batch, &device).unwrap();
+            assert!(
+                (step.loss - loss).abs() <= 1e-5 * loss,
+                "{arch:?}: loss {} vs {loss}",
+                step.loss
+            );
+            let g = compare("gradient", &net, &engine_grad, &net.params.grad, 2e-4, 1e-6);
+            // Running statistics (the only values a training step changes) agree as well.
+            let s = compare("value", &net, &engine_stats, &net.params.value, 1e-5, 1e-3);
+            println!("{arch:?}: worst relative gradient error {g:.1e}, statistics {s:.1e}");
+        }
+    }
+
+    #[test]
+    fn burns_evaluation_equals_the_engines() {
+        let device = Device::flex();
+        for arch in ALL {
+            let (c, o) = (6, 2);
+            let mut net = random_net(arch, c, o);
+            let (x, _) = data(9, c, o);
+            let engine = net.predict(&x, 9);
+            let mut module = BurnNet::new(&net.config, &device);
+            module.load(&net, &device);
+            let burn = module.predict(&x, 9, 20, &device).unwrap();
+            let scale = engine.iter().fold(1e-3f32, |m, v| m.max(v.abs()));
+            for (a, b) in engine.iter().zip(&burn) {
+                assert!((a - b).abs() <= 1e-5 * scale, "{arch:?}: {a} vs {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn training_steps_follow_the_same_trajectory() {
+        // Ten Adam steps from the same start, gradients by each engine: the weights stay
+        // together (float rounding only), so burn training is the engine's algorithm.
+        let device = Device::flex();
+        for arch in ALL {
+            let (batch, c, o) = (8, 4, 1);
+            let (x, y) = data(batch, c, o);
+            let mut fused = random_net(arch, c, o);
+            let mut viaburn = random_net(arch, c, o);
+            let mut module = BurnNet::new(&viaburn.config, &device);
+            let (mut a1, mut a2) = (
+                Adam::new(fused.params.value.len(), 1e-3),
+                Adam::new(viaburn.params.value.len(), 1e-3),
+            );
+            for step in 0..10 {
+                fused.reseed_dropout(step);
+                fused.params.zero_grad();
+                let pred = fused.forward(&x, batch, true).to_vec();
+                let dout: Vec<f32> = pred
+                    .iter()
+                    .zip(&y)
+                    .map(|(p, t)| 2.0 * (p - t) / y.len() as f32)
+                    .collect();
+                fused.backward(&x, &dout);
+                a1.step(&mut fused.params);
+                viaburn.reseed_dropout(step);
+                module
+                    .gradients(&mut viaburn, &x, &y, batch, &device)
+                    .unwrap();
+                a2.step(&mut viaburn.params);
+            }
+            // Adam's step is ±lr wherever a gradient is near zero, so rounding can flip a few
+            // single steps: compare the whole movement, not single weights.
+            let norm = |v: &mut dyn Iterator<Item = f32>| v.map(|d| f64::from(d).powi(2)).sum::<f64>().sqrt();
+            let start = random_net(arch, c, o).params.value;
+            let moved = norm(&mut fused.params.value.iter().zip(&start).map(|(a, b)| a - b));
+            let apart = norm(&mut fused.params.value.iter().zip(&viaburn.params.value).map(|(a, b)| a - b));
+            println!("{arch:?}: moved {moved:.3e}, apart {apart:.3e}");
+            assert!(
+                apart <= 0.01 * moved,
+                "{arch:?}: after 10 steps the weights moved {moved} and are {apart} apart"
+            );
+        }
+    }
+}

@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use railforce::features::{DataSet, LabelAt, NoiseProtocol, Selection, Split};
 use railforce::learn::evaluate::{EvalPart, evaluate};
 use railforce::learn::model::{Model, ModelKind};
-use railforce::learn::train::{Progress, TrainOptions, train};
+use railforce::learn::train::{GradientEngine, Progress, TrainOptions, train};
 use railforce::learn::windows::DataSpec;
 use railforce::sensors::PAPER_CHANNELS;
 use std::path::{Path, PathBuf};
@@ -107,6 +107,13 @@ pub struct TrainArgs {
     /// columns).
     #[arg(long)]
     fixed_noise: bool,
+    /// Networks: what computes each minibatch's forward and backward pass. `fused`, the
+    /// hand-fused engine, is the fast CPU path; `burn-cpu` runs the same network as burn
+    /// modules with burn's autodiff (build with `--features burn`), `burn-cuda` on an NVIDIA GPU
+    /// (`--features burn-cuda`). Same weights, optimizer, dropout stream and model directory:
+    /// a model or checkpoint of either engine loads and resumes in the other.
+    #[arg(long, default_value = "fused", value_parser = ["fused", "burn-cpu", "burn-cuda"])]
+    engine: String,
 }
 
 /// Resolves the data options into a [`DataSpec`].
@@ -298,6 +305,11 @@ pub fn run(args: TrainArgs) -> Result<()> {
         } else {
             None
         },
+        engine: match args.engine.as_str() {
+            "burn-cpu" => GradientEngine::BurnCpu,
+            "burn-cuda" => GradientEngine::BurnCuda,
+            _ => GradientEngine::Fused,
+        },
         ..TrainOptions::default()
     };
     let short = |t: &String| target_name(t, &ds.labels);
@@ -338,14 +350,19 @@ pub fn run(args: TrainArgs) -> Result<()> {
     println!("  split: {}", spec.split.describe());
     if kind.architecture().is_some() {
         println!(
-            "  Adam lr {}, batch {}, at most {} epochs, patience {}, {} training windows per epoch",
+            "  Adam lr {}, batch {}, at most {} epochs, patience {}, {} training windows per epoch; gradients by {}",
             opts.lr,
             opts.batch,
             opts.epochs,
             opts.patience,
             opts.windows_per_epoch
                 .map(|w| w.to_string())
-                .unwrap_or("all".into())
+                .unwrap_or("all".into()),
+            match opts.engine {
+                GradientEngine::Fused => "the fused engine",
+                GradientEngine::BurnCpu => "burn (CPU, Flex backend)",
+                GradientEngine::BurnCuda => "burn (CUDA)",
+            }
         );
     } else {
         println!(

@@ -1,6 +1,8 @@
 //! Learning: networks and classical regressors on leak-free windows, the trainer, metrics and
 //! model directories.
 
+#[cfg(feature = "burn")]
+pub mod burn;
 pub mod classical;
 pub mod evaluate;
 pub mod export;

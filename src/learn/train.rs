@@ -46,6 +46,35 @@ pub struct TrainOptions {
     /// Validation windows scored each epoch at most (evenly strided; all when `None`).
     #[serde(default)]
     pub val_windows: Option<usize>,
+    /// What computes each minibatch's forward and backward pass (networks only).
+    #[serde(default)]
+    pub engine: GradientEngine,
+}
+
+/// What computes a network's forward and backward pass in training. The weights, Adam, the
+/// dropout stream, checkpoints and the model directory are the same for all: a model or a
+/// checkpoint of one engine loads (and resumes) in the other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GradientEngine {
+    /// The hand-fused engine (the fast CPU path).
+    #[default]
+    Fused,
+    /// burn's autodiff on its CPU backend (Flex); needs `--features burn`.
+    BurnCpu,
+    /// burn's autodiff on CUDA (GPU 0); needs `--features burn-cuda`.
+    BurnCuda,
+}
+
+impl GradientEngine {
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            GradientEngine::Fused => "fused",
+            GradientEngine::BurnCpu => "burn-cpu",
+            GradientEngine::BurnCuda => "burn-cuda",
+        }
+    }
 }
 
 impl Default for TrainOptions {
@@ -62,6 +91,7 @@ impl Default for TrainOptions {
             resume: false,
             fresh_noise: None,
             val_windows: None,
+            engine: GradientEngine::Fused,
         }
     }
 }
@@ -280,8 +310,61 @@ struct NetJob<'a> {
 
 /// Where a network's training stands: weights, optimiser, the best weights so far, the
 /// early-stopping counters and the epoch log — exactly what a checkpoint holds.
+/// The gradient computation of one training step.
+enum Stepper {
+    Fused,
+    #[cfg(feature = "burn")]
+    Burn(Box<super::burn::BurnNet>, ::burn::tensor::Device),
+}
+
+impl Stepper {
+    fn new(engine: GradientEngine, config: &NetConfig) -> Result<Self> {
+        match engine {
+            GradientEngine::Fused => Ok(Stepper::Fused),
+            #[cfg(feature = "burn")]
+            burn => {
+                let device = super::burn::device(burn)?;
+                let net = super::burn::BurnNet::new(config, &device);
+                Ok(Stepper::Burn(Box::new(net), device))
+            }
+            #[cfg(not(feature = "burn"))]
+            other => {
+                let _ = config;
+                Err(Error::Domain(format!(
+                    "--engine {} needs burn, and this railforce was built without it: rebuild with `cargo build --release --features {}`",
+                    other.name(),
+                    if other == GradientEngine::BurnCuda { "burn-cuda" } else { "burn" }
+                )))
+            }
+        }
+    }
+
+    /// Gradients of the mean squared error of `y` on `x` into `net.params.grad`; the loss.
+    fn step(&mut self, net: &mut Network, x: &[f32], y: &[f32], n: usize, dout: &mut Vec<f32>) -> Result<f64> {
+        match self {
+            Stepper::Fused => {
+                net.params.zero_grad();
+                let pred = net.forward(x, n, true);
+                dout.clear();
+                let scale = 2.0 / y.len() as f32;
+                let mut l = 0.0f64;
+                for (p, t) in pred.iter().zip(y.iter()) {
+                    let e = p - t;
+                    l += (e * e) as f64;
+                    dout.push(scale * e);
+                }
+                net.backward(x, dout);
+                Ok(l / y.len() as f64)
+            }
+            #[cfg(feature = "burn")]
+            Stepper::Burn(module, device) => Ok(module.gradients(net, x, y, n, device)?.loss),
+        }
+    }
+}
+
 struct Trainer {
     net: Network,
+    stepper: Stepper,
     adam: Adam,
     best: Vec<f32>,
     best_val: f64,
@@ -292,12 +375,14 @@ struct Trainer {
 }
 
 impl Trainer {
-    fn new(config: &NetConfig, opts: &TrainOptions) -> Self {
+    fn new(config: &NetConfig, opts: &TrainOptions) -> Result<Self> {
         let net = Network::new(config.clone());
+        let stepper = Stepper::new(opts.engine, config)?;
         let adam = Adam::new(net.params.value.len(), opts.lr);
         let best = net.params.value.clone();
-        Trainer {
+        Ok(Trainer {
             net,
+            stepper,
             adam,
             best,
             best_val: f64::INFINITY,
@@ -305,7 +390,7 @@ impl Trainer {
             bad: 0,
             start: 0,
             log: Vec::new(),
-        }
+        })
     }
 
     /// Identifies the model, data and settings a checkpoint belongs to.
@@ -398,17 +483,7 @@ impl Trainer {
         let mut loss_sum = 0.0f64;
         for (bi, chunk) in order.chunks(batch).enumerate() {
             train.gather(chunk, x, y);
-            self.net.params.zero_grad();
-            let pred = self.net.forward(x, chunk.len(), true);
-            dout.clear();
-            let scale = 2.0 / y.len() as f32;
-            let mut l = 0.0f64;
-            for (p, t) in pred.iter().zip(y.iter()) {
-                let e = p - t;
-                l += (e * e) as f64;
-                dout.push(scale * e);
-            }
-            let l = l / y.len() as f64;
+            let l = self.stepper.step(&mut self.net, x, y, chunk.len(), dout)?;
             if !l.is_finite() {
                 return Err(Error::Domain(format!(
                     "training diverged at epoch {epoch}, batch {} (loss {l}); lower --lr",
@@ -416,7 +491,6 @@ impl Trainer {
                 )));
             }
             loss_sum += l * chunk.len() as f64;
-            self.net.backward(x, dout);
             self.adam.step(&mut self.net.params);
             if bi % 16 == 0 || bi + 1 == batches {
                 progress(Progress::Batch {
@@ -494,7 +568,7 @@ fn train_network(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<(Network, serde_json::Value)> {
     let opts = job.opts;
-    let mut t = Trainer::new(&job.config, opts);
+    let mut t = Trainer::new(&job.config, opts)?;
     let fingerprint = Trainer::fingerprint(job);
     if opts.resume && job.out.join("checkpoint.json").exists() {
         t.resume(job.out, &fingerprint)?;

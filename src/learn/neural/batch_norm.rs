@@ -6,8 +6,10 @@
 use super::params::ParamSet;
 use std::ops::Range;
 
-const EPS: f32 = 1e-5;
-const MOMENTUM: f32 = 0.1;
+/// Variance floor ε (PyTorch's default).
+pub const EPS: f32 = 1e-5;
+/// Running-statistics momentum (PyTorch's default).
+pub const MOMENTUM: f32 = 0.1;
 
 /// A batch-norm layer and its cache for the backward pass.
 #[derive(Debug, Clone)]

@@ -58,8 +58,14 @@ pub struct NetConfig {
     pub seed: u64,
 }
 
-const STEM_WIDTH: usize = 128;
-const HIDDEN: usize = 20;
+/// Channels of the stem's second convolution.
+pub const STEM_WIDTH: usize = 128;
+/// Hidden units of the recurrent layers (per direction).
+pub const HIDDEN: usize = 20;
+/// Widths of the head's two hidden layers.
+pub const HEAD: [usize; 2] = [64, 8];
+/// Negative slope of every LeakyReLU.
+pub const LEAKY: f32 = LEAKY_SLOPE;
 
 struct Stem {
     c1: Dense,
@@ -86,6 +92,7 @@ pub struct Network {
     d2: Dense,
     d3: Dense,
     rng: ChaCha8Rng,
+    feat_width: usize,
     batch: usize,
     r1: Vec<f32>,
     n1: Vec<f32>,
@@ -138,9 +145,9 @@ impl Network {
             }
             Architecture::Cnn => (Recurrent::None, (t - 1) * STEM_WIDTH),
         };
-        let d1 = Dense::new(&mut p, "head.fc1", feat, 64, &mut rng);
-        let d2 = Dense::new(&mut p, "head.fc2", 64, 8, &mut rng);
-        let d3 = Dense::new(&mut p, "head.out", 8, config.outputs, &mut rng);
+        let d1 = Dense::new(&mut p, "head.fc1", feat, HEAD[0], &mut rng);
+        let d2 = Dense::new(&mut p, "head.fc2", HEAD[0], HEAD[1], &mut rng);
+        let d3 = Dense::new(&mut p, "head.out", HEAD[1], config.outputs, &mut rng);
         let dropout_rng = ChaCha8Rng::seed_from_u64(config.seed ^ 0x000D_80F0_u64);
         Network {
             config,
@@ -151,6 +158,7 @@ impl Network {
             d2,
             d3,
             rng: dropout_rng,
+            feat_width: feat,
             batch: 0,
             r1: Vec::new(),
             n1: Vec::new(),
@@ -172,6 +180,24 @@ impl Network {
     /// Re-seeds the dropout stream (the trainer does so per epoch for resumable runs).
     pub fn reseed_dropout(&mut self, seed: u64) {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
+    }
+
+    /// Width of the features the head receives (2H, H or (window − 1)·128).
+    pub fn feature_width(&self) -> usize {
+        self.feat_width
+    }
+
+    /// The head's two dropout masks for `batch` windows (`[B, features]` and `[B, 64]`, each
+    /// value 0 or 1/(1 − q)), drawn from the network's dropout stream exactly as a training
+    /// forward pass draws them: another engine (burn) trained through [`Network`] meets the
+    /// same masks.
+    pub fn dropout_masks(&mut self, batch: usize) -> [Vec<f32>; 2] {
+        let q = self.config.dropout;
+        let mut m0 = Vec::new();
+        let mut m1 = Vec::new();
+        draw_mask(batch * self.feat_width, q, true, &mut self.rng, &mut m0);
+        draw_mask(batch * HEAD[0], q, true, &mut self.rng, &mut m1);
+        [m0, m1]
     }
 
     /// Forward pass of `x[B, window, channels]` (z-scored); `train` enables dropout and batch
@@ -427,18 +453,21 @@ fn dropout(
     train: bool,
     rng: &mut ChaCha8Rng,
 ) {
+    draw_mask(x.len(), q, train, rng, mask);
+    y.clear();
+    y.extend(x.iter().zip(mask.iter()).map(|(a, m)| a * m));
+}
+
+/// `n` inverted-dropout multipliers: 0 with probability `q`, else 1/(1 − q); all 1 outside
+/// training.
+fn draw_mask(n: usize, q: f32, train: bool, rng: &mut ChaCha8Rng, mask: &mut Vec<f32>) {
     mask.clear();
     if train && q > 0.0 {
         let keep = 1.0 / (1.0 - q);
-        mask.extend(
-            x.iter()
-                .map(|_| if rng.random::<f32>() < q { 0.0 } else { keep }),
-        );
+        mask.extend((0..n).map(|_| if rng.random::<f32>() < q { 0.0 } else { keep }));
     } else {
-        mask.resize(x.len(), 1.0);
+        mask.resize(n, 1.0);
     }
-    y.clear();
-    y.extend(x.iter().zip(mask.iter()).map(|(a, m)| a * m));
 }
 
 fn mul_in_place(x: &mut [f32], m: &[f32]) {
