@@ -319,3 +319,75 @@ fn fresh_noise_needs_the_matched_protocol() {
     .unwrap();
     assert!(err.to_string().contains("matched"), "{err}");
 }
+
+/// `--engine burn-cpu` trains the same model as the fused engine (the same files, loaded and
+/// evaluated by the engine), and a checkpoint of one engine resumes in the other.
+#[cfg(feature = "burn")]
+#[test]
+fn burn_trains_the_engines_model_and_resumes_its_checkpoints() {
+    use railforce::learn::train::GradientEngine;
+    let ds = synthetic(2, 300);
+    for kind in [ModelKind::CnnBiLstm, ModelKind::Gru] {
+        let fused_dir = tmp(&format!("fused-{}", kind.name()));
+        let burn_dir = tmp(&format!("burn-{}", kind.name()));
+        let mut fused = train(&ds, &spec(), kind, &quick(3), &fused_dir, &mut |_| {}).unwrap();
+        let burn_opts = TrainOptions {
+            engine: GradientEngine::BurnCpu,
+            ..quick(3)
+        };
+        train(&ds, &spec(), kind, &burn_opts, &burn_dir, &mut |_| {}).unwrap();
+        // The burn-trained directory is an ordinary model: the engine loads and evaluates it.
+        let mut by_burn = Model::load(&burn_dir).unwrap();
+        let a = evaluate(&mut fused, &ds, EvalPart::Test).unwrap();
+        let b = evaluate(&mut by_burn, &ds, EvalPart::Test).unwrap();
+        let (la, lb) = (a.metrics[0].mse, b.metrics[0].mse);
+        assert!(
+            (la - lb).abs() <= 0.02 * la,
+            "{}: test MSE fused {la} vs burn {lb}",
+            kind.name()
+        );
+        // And the other way: burn loads the model directory and predicts the same numbers.
+        let railforce::learn::model::Engine::Net(net) = &mut by_burn.engine else {
+            unreachable!("a network")
+        };
+        let device = burn::tensor::Device::flex();
+        let mut module = railforce::learn::burn::BurnNet::new(&net.config, &device);
+        module.load(net, &device);
+        let x: Vec<f32> = (0..10 * 8 * 3).map(|i| (i as f32 * 0.37).sin()).collect();
+        let by_engine = net.predict(&x, 10);
+        let in_burn = module.predict(&x, 10, 8, &device).unwrap();
+        for (e, b) in by_engine.iter().zip(&in_burn) {
+            assert!((e - b).abs() <= 1e-5 * e.abs().max(1.0), "{e} vs {b}");
+        }
+        // Resume the burn run with the fused engine for two more epochs: it continues.
+        let more = TrainOptions {
+            resume: true,
+            ..quick(5)
+        };
+        let resumed = train(&ds, &spec(), kind, &more, &burn_dir, &mut |_| {}).unwrap();
+        assert_eq!(resumed.meta.training["epochs_run"], 5, "{}", kind.name());
+    }
+}
+
+#[cfg(not(feature = "burn"))]
+#[test]
+fn the_burn_engine_without_burn_says_how_to_build_it() {
+    use railforce::learn::train::GradientEngine;
+    let ds = synthetic(1, 200);
+    let opts = TrainOptions {
+        engine: GradientEngine::BurnCpu,
+        ..quick(1)
+    };
+    let err = train(
+        &ds,
+        &spec(),
+        ModelKind::Gru,
+        &opts,
+        &tmp("noburn"),
+        &mut |_| {},
+    )
+    .err()
+    .expect("refused")
+    .to_string();
+    assert!(err.contains("--features burn"), "{err}");
+}

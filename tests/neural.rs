@@ -231,7 +231,11 @@ mod against_burn {
             net.params.zero_grad();
             let pred = net.forward(&x, batch, true).to_vec();
             let n = y.len() as f32;
-            let dout: Vec<f32> = pred.iter().zip(&y).map(|(p, t)| 2.0 * (p - t) / n).collect();
+            let dout: Vec<f32> = pred
+                .iter()
+                .zip(&y)
+                .map(|(p, t)| 2.0 * (p - t) / n)
+                .collect();
             let loss: f64 = pred
                 .iter()
                 .zip(&y)
@@ -310,10 +314,19 @@ mod against_burn {
             }
             // Adam's step is ±lr wherever a gradient is near zero, so rounding can flip a few
             // single steps: compare the whole movement, not single weights.
-            let norm = |v: &mut dyn Iterator<Item = f32>| v.map(|d| f64::from(d).powi(2)).sum::<f64>().sqrt();
+            let norm = |v: &mut dyn Iterator<Item = f32>| {
+                v.map(|d| f64::from(d).powi(2)).sum::<f64>().sqrt()
+            };
             let start = random_net(arch, c, o).params.value;
             let moved = norm(&mut fused.params.value.iter().zip(&start).map(|(a, b)| a - b));
-            let apart = norm(&mut fused.params.value.iter().zip(&viaburn.params.value).map(|(a, b)| a - b));
+            let apart = norm(
+                &mut fused
+                    .params
+                    .value
+                    .iter()
+                    .zip(&viaburn.params.value)
+                    .map(|(a, b)| a - b),
+            );
             println!("{arch:?}: moved {moved:.3e}, apart {apart:.3e}");
             assert!(
                 apart <= 0.01 * moved,

@@ -310,15 +310,19 @@ struct NetJob<'a> {
 
 /// Where a network's training stands: weights, optimiser, the best weights so far, the
 /// early-stopping counters and the epoch log — exactly what a checkpoint holds.
-/// The gradient computation of one training step.
-enum Stepper {
+/// The gradient computation of one training step, by the chosen [`GradientEngine`]: what the
+/// trainer runs and `bench learn` times.
+pub enum Stepper {
+    /// The hand-fused engine.
     Fused,
+    /// burn's autodiff on a device.
     #[cfg(feature = "burn")]
     Burn(Box<super::burn::BurnNet>, ::burn::tensor::Device),
 }
 
 impl Stepper {
-    fn new(engine: GradientEngine, config: &NetConfig) -> Result<Self> {
+    /// The stepper of `engine` for networks of `config`; an error when this build lacks it.
+    pub fn new(engine: GradientEngine, config: &NetConfig) -> Result<Self> {
         match engine {
             GradientEngine::Fused => Ok(Stepper::Fused),
             #[cfg(feature = "burn")]
@@ -333,14 +337,26 @@ impl Stepper {
                 Err(Error::Domain(format!(
                     "--engine {} needs burn, and this railforce was built without it: rebuild with `cargo build --release --features {}`",
                     other.name(),
-                    if other == GradientEngine::BurnCuda { "burn-cuda" } else { "burn" }
+                    if other == GradientEngine::BurnCuda {
+                        "burn-cuda"
+                    } else {
+                        "burn"
+                    }
                 )))
             }
         }
     }
 
-    /// Gradients of the mean squared error of `y` on `x` into `net.params.grad`; the loss.
-    fn step(&mut self, net: &mut Network, x: &[f32], y: &[f32], n: usize, dout: &mut Vec<f32>) -> Result<f64> {
+    /// Gradients of the mean squared error of `y` on `x` (`n` windows, training mode) into
+    /// `net.params.grad`, replacing them; returns the loss. `dout` is scratch space.
+    pub fn step(
+        &mut self,
+        net: &mut Network,
+        x: &[f32],
+        y: &[f32],
+        n: usize,
+        dout: &mut Vec<f32>,
+    ) -> Result<f64> {
         match self {
             Stepper::Fused => {
                 net.params.zero_grad();

@@ -4,6 +4,7 @@
 
 use railforce::learn::linalg::gemm;
 use railforce::learn::neural::{Adam, Architecture, NetConfig, Network};
+use railforce::learn::train::{GradientEngine, Stepper};
 use std::time::Instant;
 
 /// One architecture's figures.
@@ -49,40 +50,61 @@ pub fn gemm_gflops() -> f64 {
     2.0 * (m * k * n * reps) as f64 / t0.elapsed().as_secs_f64() / 1e9
 }
 
-/// Measures one architecture on 21-channel, 20-step windows for about `seconds` per figure.
-pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
-    let config = NetConfig {
+fn bench_config(architecture: Architecture) -> NetConfig {
+    NetConfig {
         architecture,
         window: 20,
         channels: 21,
         outputs: 1,
         dropout: 0.2,
         seed: 1,
-    };
+    }
+}
+
+fn windows(batch: usize) -> Vec<f32> {
+    (0..batch * 20 * 21)
+        .map(|i| ((i as f32) * 0.618).sin())
+        .collect()
+}
+
+/// Training windows per second (forward + backward + Adam, what `train` runs) of one
+/// architecture on 21-channel, 20-step windows with gradients by `engine`, for about
+/// `seconds` after three warm-up steps (a GPU backend compiles its kernels then).
+pub fn train_rate(
+    architecture: Architecture,
+    engine: GradientEngine,
+    batch: usize,
+    seconds: f64,
+) -> railforce::Result<f64> {
+    let config = bench_config(architecture);
+    let mut stepper = Stepper::new(engine, &config)?;
     let mut net = Network::new(config);
     let mut adam = Adam::new(net.params.value.len(), 1e-3);
-    let per = 20 * 21;
-    let x: Vec<f32> = (0..batch * per)
-        .map(|i| ((i as f32) * 0.618).sin())
-        .collect();
+    let x = windows(batch);
     let y: Vec<f32> = (0..batch).map(|i| ((i as f32) * 0.1).cos()).collect();
-    let mut dout = vec![0.0f32; batch];
+    let mut dout = Vec::new();
+    for _ in 0..3 {
+        stepper.step(&mut net, &x, &y, batch, &mut dout)?;
+        adam.step(&mut net.params);
+    }
     let mut done = 0usize;
     let t0 = Instant::now();
     while t0.elapsed().as_secs_f64() < seconds || done == 0 {
-        net.params.zero_grad();
-        let out = net.forward(&x, batch, true);
-        for ((d, p), t) in dout.iter_mut().zip(out).zip(&y) {
-            *d = 2.0 * (p - t) / batch as f32;
-        }
-        net.backward(&x, &dout);
+        stepper.step(&mut net, &x, &y, batch, &mut dout)?;
         adam.step(&mut net.params);
         done += batch;
     }
-    let train = done as f64 / t0.elapsed().as_secs_f64();
-    let big: Vec<f32> = (0..1024 * per)
-        .map(|i| ((i as f32) * 0.618).sin())
-        .collect();
+    Ok(done as f64 / t0.elapsed().as_secs_f64())
+}
+
+/// Measures one architecture with the fused engine on 21-channel, 20-step windows for about
+/// `seconds` per figure.
+pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
+    let train = train_rate(architecture, GradientEngine::Fused, batch, seconds)
+        .expect("the fused engine is always built");
+    let mut net = Network::new(bench_config(architecture));
+    let per = 20 * 21;
+    let big = windows(1024);
     let mut n = 0usize;
     let t0 = Instant::now();
     while t0.elapsed().as_secs_f64() < seconds || n == 0 {
@@ -102,6 +124,45 @@ pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
         single_ms: t0.elapsed().as_secs_f64() * 1e3 / k as f64,
         pytorch_train_reference: pytorch_reference(architecture),
     }
+}
+
+/// Training rates with gradients by burn (`engines`: `burn-cpu`, `burn-cuda`) for the four
+/// networks at each batch size, each beside the fused engine at the same batch measured in the
+/// same run (the reference the ratio is read against).
+pub fn burn_table(engines: &[String], batches: &[usize], seconds: f64) -> anyhow::Result<()> {
+    use Architecture as A;
+    let engines: Vec<GradientEngine> = engines
+        .iter()
+        .map(|e| match e.as_str() {
+            "burn-cuda" => GradientEngine::BurnCuda,
+            _ => GradientEngine::BurnCpu,
+        })
+        .collect();
+    println!(
+        "training with gradients by burn 0.22 (21 channels × 20 steps; weights upload and gradients read back every step, Adam in the engine)"
+    );
+    println!(
+        "{:<11} {:>6} {:<10} {:>12} {:>15} {:>10}",
+        "network", "batch", "engine", "train win/s", "fused win/s", "vs fused"
+    );
+    for a in [A::CnnBiLstm, A::Cnn, A::BiLstm, A::Gru] {
+        for &batch in batches {
+            let fused = train_rate(a, GradientEngine::Fused, batch, seconds)?;
+            for &engine in &engines {
+                let rate = train_rate(a, engine, batch, seconds)?;
+                println!(
+                    "{:<11} {:>6} {:<10} {:>12.0} {:>15.0} {:>9.2}×",
+                    a.name(),
+                    batch,
+                    engine.name(),
+                    rate,
+                    fused,
+                    rate / fused
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Seconds to fit `params` on `n` synthetic windows of `f` features (one output), and the

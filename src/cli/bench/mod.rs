@@ -25,6 +25,17 @@ enum What {
         /// Rows of the boosting fit (0 skips it).
         #[arg(long, default_value_t = 40_000)]
         rows: usize,
+        /// Also time training with gradients by burn: `burn-cpu` (Flex backend, needs
+        /// `--features burn`) and/or `burn-cuda` (needs `--features burn-cuda` and a GPU),
+        /// comma separated, each beside the fused engine at the same batch.
+        #[arg(long, value_delimiter = ',', value_parser = ["burn-cpu", "burn-cuda"])]
+        burn: Vec<String>,
+        /// Batch sizes of the burn figures.
+        #[arg(long, value_delimiter = ',', default_value = "64")]
+        batches: Vec<usize>,
+        /// Only the burn figures (skip the fused table, inference and boosting).
+        #[arg(long)]
+        burn_only: bool,
     },
     /// One wheel's contact evaluation during a simulation step (table lookup + Hertz +
     /// creepages + Polach), against FASTSIM and a full rigid solve measured in the same run.
@@ -58,11 +69,20 @@ enum What {
 
 pub fn run(args: BenchArgs) -> Result<()> {
     match args.what {
-        What::Learn { seconds, rows } => {
+        What::Learn {
+            seconds,
+            rows,
+            burn,
+            batches,
+            burn_only,
+        } => {
             use learn;
             use railforce::learn::neural::Architecture as A;
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench learn`");
+            }
+            if burn_only {
+                return learn::burn_table(&burn, &batches, seconds);
             }
             let gf = learn::gemm_gflops();
             println!("GEMM [1216×128]·[128×160], one thread: {gf:.1} GFLOP/s (hardware reference)");
@@ -105,6 +125,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 "streaming identification (cnn-bilstm, FL + FQ): {lat:.1} µs per new sample, {:.0}× inside the 5 ms sampling interval",
                 5000.0 / lat
             );
+            if !burn.is_empty() {
+                learn::burn_table(&burn, &batches, seconds)?;
+            }
             if rows > 0 {
                 use railforce::learn::classical::ClassicalParams;
                 for (name, p, reference) in [

@@ -11,9 +11,9 @@
 use super::{BurnNet, to_vec};
 use crate::error::{Error, Result};
 use crate::learn::neural::ParamSet;
-use crate::learn::neural::params::Slot;
 use crate::learn::neural::batch_norm::MOMENTUM;
 use crate::learn::neural::network::HIDDEN;
+use crate::learn::neural::params::Slot;
 use ::burn::module::{Param, RunningState};
 use ::burn::nn::{BatchNorm, GateController, Linear};
 use ::burn::tensor::Gradients;
@@ -59,7 +59,11 @@ impl Block {
     fn gather(&self, slots: &[Slot], values: &[f32]) -> Result<(Vec<f32>, usize, usize)> {
         let (start, stride, nr, nc) = self.locate(slots)?;
         let data = (0..nr)
-            .flat_map(|r| values[start + r * stride..start + r * stride + nc].iter().copied())
+            .flat_map(|r| {
+                values[start + r * stride..start + r * stride + nc]
+                    .iter()
+                    .copied()
+            })
             .collect();
         Ok((data, nr, nc))
     }
@@ -166,7 +170,10 @@ fn visit(net: &mut BurnNet, f: &mut Visit) -> Result<()> {
     }
     if let Some(lstm) = &mut net.lstm {
         for (d, dir) in [(0, &mut lstm.forward), (1, &mut lstm.reverse)] {
-            let forget = dir.forget_gate.as_mut().expect("no coupled input-forget gate");
+            let forget = dir
+                .forget_gate
+                .as_mut()
+                .expect("no coupled input-forget gate");
             // Engine gate order i, f, g, o.
             for (k, g) in [
                 (0, &mut dir.input_gate),
@@ -232,7 +239,11 @@ pub(super) fn load(net: &mut BurnNet, p: &ParamSet, device: &Device) {
 
 /// Writes the gradients of a backward pass into `p.grad` (a tensor burn reports none for gets
 /// zeros: it did not take part).
-pub(super) fn store_gradients(net: &mut BurnNet, grads: &Gradients, p: &mut ParamSet) -> Result<()> {
+pub(super) fn store_gradients(
+    net: &mut BurnNet,
+    grads: &Gradients,
+    p: &mut ParamSet,
+) -> Result<()> {
     p.grad.fill(0.0);
     let (slots, grad) = (&p.slots, &mut p.grad);
     visit(net, &mut |target, block| {
