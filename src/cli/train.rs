@@ -109,10 +109,10 @@ pub struct TrainArgs {
     fixed_noise: bool,
     /// Networks: what computes each minibatch's forward and backward pass. `fused`, the
     /// hand-fused engine, is the fast CPU path; `burn-cpu` runs the same network as burn
-    /// modules with burn's autodiff (build with `--features burn`), `burn-cuda` on an NVIDIA GPU
-    /// (`--features burn-cuda`). Same weights, optimizer, dropout stream and model directory:
+    /// modules with burn's autodiff (build with `--features burn`), `burn-gpu` on an NVIDIA GPU
+    /// (`--features burn-gpu`). Same weights, optimizer, dropout stream and model directory:
     /// a model or checkpoint of either engine loads and resumes in the other.
-    #[arg(long, default_value = "fused", value_parser = ["fused", "burn-cpu", "burn-cuda"])]
+    #[arg(long, default_value = "fused", value_parser = ["fused", "burn-cpu", "burn-gpu"])]
     engine: String,
 }
 
@@ -307,7 +307,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         },
         engine: match args.engine.as_str() {
             "burn-cpu" => GradientEngine::BurnCpu,
-            "burn-cuda" => GradientEngine::BurnCuda,
+            "burn-gpu" => GradientEngine::BurnGpu,
             _ => GradientEngine::Fused,
         },
         ..TrainOptions::default()
@@ -361,7 +361,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
             match opts.engine {
                 GradientEngine::Fused => "the fused engine",
                 GradientEngine::BurnCpu => "burn (CPU, Flex backend)",
-                GradientEngine::BurnCuda => "burn (CUDA)",
+                GradientEngine::BurnGpu => "burn (GPU, wgpu over Vulkan)",
             }
         );
     } else {

@@ -62,8 +62,8 @@ pub enum GradientEngine {
     Fused,
     /// burn's autodiff on its CPU backend (Flex); needs `--features burn`.
     BurnCpu,
-    /// burn's autodiff on CUDA (GPU 0); needs `--features burn-cuda`.
-    BurnCuda,
+    /// burn's autodiff on a GPU through wgpu and Vulkan; needs `--features burn-gpu`.
+    BurnGpu,
 }
 
 impl GradientEngine {
@@ -72,7 +72,7 @@ impl GradientEngine {
         match self {
             GradientEngine::Fused => "fused",
             GradientEngine::BurnCpu => "burn-cpu",
-            GradientEngine::BurnCuda => "burn-cuda",
+            GradientEngine::BurnGpu => "burn-gpu",
         }
     }
 }
@@ -337,8 +337,8 @@ impl Stepper {
                 Err(Error::Domain(format!(
                     "--engine {} needs burn, and this railforce was built without it: rebuild with `cargo build --release --features {}`",
                     other.name(),
-                    if other == GradientEngine::BurnCuda {
-                        "burn-cuda"
+                    if other == GradientEngine::BurnGpu {
+                        "burn-gpu"
                     } else {
                         "burn"
                     }

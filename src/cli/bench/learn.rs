@@ -126,7 +126,7 @@ pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
     }
 }
 
-/// Training rates with gradients by burn (`engines`: `burn-cpu`, `burn-cuda`) for the four
+/// Training rates with gradients by burn (`engines`: `burn-cpu`, `burn-gpu`) for the four
 /// networks at each batch size, each beside the fused engine at the same batch measured in the
 /// same run (the reference the ratio is read against).
 pub fn burn_table(engines: &[String], batches: &[usize], seconds: f64) -> anyhow::Result<()> {
@@ -134,7 +134,7 @@ pub fn burn_table(engines: &[String], batches: &[usize], seconds: f64) -> anyhow
     let engines: Vec<GradientEngine> = engines
         .iter()
         .map(|e| match e.as_str() {
-            "burn-cuda" => GradientEngine::BurnCuda,
+            "burn-gpu" => GradientEngine::BurnGpu,
             _ => GradientEngine::BurnCpu,
         })
         .collect();

@@ -26,9 +26,9 @@ enum What {
         #[arg(long, default_value_t = 40_000)]
         rows: usize,
         /// Also time training with gradients by burn: `burn-cpu` (Flex backend, needs
-        /// `--features burn`) and/or `burn-cuda` (needs `--features burn-cuda` and a GPU),
+        /// `--features burn`) and/or `burn-gpu` (needs `--features burn-gpu` and a GPU),
         /// comma separated, each beside the fused engine at the same batch.
-        #[arg(long, value_delimiter = ',', value_parser = ["burn-cpu", "burn-cuda"])]
+        #[arg(long, value_delimiter = ',', value_parser = ["burn-cpu", "burn-gpu"])]
         burn: Vec<String>,
         /// Batch sizes of the burn figures.
         #[arg(long, value_delimiter = ',', default_value = "64")]

@@ -27,20 +27,58 @@ use ::burn::nn::{
 use ::burn::tensor::activation::leaky_relu;
 use ::burn::tensor::{Device, Tensor, TensorData};
 
-/// The burn device (without autodiff) of a gradient engine: burn-flex on the CPU, or CUDA
-/// GPU 0 (an error when this build lacks the backend, or for the fused engine).
+/// The burn device (without autodiff) of a gradient engine: burn-flex on the CPU, or the best
+/// GPU wgpu finds through Vulkan (an error when this build lacks the backend, or for the fused
+/// engine).
 pub fn device(engine: GradientEngine) -> Result<Device> {
     match engine {
         GradientEngine::BurnCpu => Ok(Device::flex()),
-        #[cfg(feature = "burn-cuda")]
-        GradientEngine::BurnCuda => Ok(Device::cuda(0)),
-        #[cfg(not(feature = "burn-cuda"))]
-        GradientEngine::BurnCuda => Err(Error::Domain(
-            "this railforce was built without burn's CUDA backend: rebuild with `cargo build --release --features burn-cuda`".into(),
+        #[cfg(feature = "burn-gpu")]
+        GradientEngine::BurnGpu => gpu(),
+        #[cfg(not(feature = "burn-gpu"))]
+        GradientEngine::BurnGpu => Err(Error::Domain(
+            "this railforce was built without burn's GPU backend: rebuild with `cargo build --release --features burn-gpu`".into(),
         )),
         GradientEngine::Fused => Err(Error::Domain(
             "the fused engine is not a burn device".into(),
         )),
+    }
+}
+
+/// The best GPU wgpu finds through Vulkan, probed with one small tensor: burn's runtime
+/// panics (in its own thread) when there is no adapter, which becomes an error naming what is
+/// missing.
+#[cfg(feature = "burn-gpu")]
+fn gpu() -> Result<Device> {
+    use std::sync::{Arc, Mutex};
+    let device = Device::vulkan(::burn::tensor::DeviceKind::DefaultDevice);
+    let probe = device.clone();
+    let said = Arc::new(Mutex::new(Vec::<String>::new()));
+    let keep = Arc::clone(&said);
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if let Ok(mut v) = keep.lock() {
+            v.push(info.to_string());
+        }
+    }));
+    let probed = std::panic::catch_unwind(move || {
+        Tensor::<1>::from_floats([1.0, 2.0], &probe)
+            .sum()
+            .into_data()
+    });
+    std::panic::set_hook(hook);
+    match probed {
+        Ok(_) => Ok(device),
+        Err(_) => {
+            let said = said
+                .lock()
+                .ok()
+                .and_then(|v| v.first().cloned())
+                .unwrap_or_default();
+            Err(Error::Domain(format!(
+                "no GPU reachable through Vulkan for --engine burn-gpu (install the GPU's Vulkan driver and loader, libvulkan1; or use burn-cpu or fused): {said}"
+            )))
+        }
     }
 }
 
@@ -242,6 +280,6 @@ fn norm_rows(bn: &BatchNorm, h: Tensor<3>) -> Tensor<3> {
 /// A tensor's values as f32.
 fn to_vec<const D: usize>(t: Tensor<D>) -> Result<Vec<f32>> {
     t.into_data()
-        .into_vec::<f32>()
+        .try_into_vec::<f32>()
         .map_err(|e| Error::Domain(format!("burn tensor: {e:?}")))
 }

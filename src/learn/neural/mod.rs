@@ -1,5 +1,6 @@
 //! Neural networks: the paper's CNN-BiLSTM and the CNN, BiLSTM and GRU baselines, with
-//! hand-fused forward and backward passes on f32 buffers (see the README for why not burn).
+//! hand-fused forward and backward passes on f32 buffers: the fast CPU path (the same networks
+//! as burn modules are in `learn::burn`, `--features burn`).
 
 pub mod adam;
 pub mod batch_norm;
