@@ -172,6 +172,7 @@ mod against_burn {
     use burn::tensor::Device;
     use railforce::learn::burn::BurnNet;
     use railforce::learn::neural::{Adam, Architecture, Network};
+    use railforce::learn::train::{GradientEngine, Stepper};
 
     const ALL: [Architecture; 4] = [
         Architecture::CnnBiLstm,
@@ -228,21 +229,11 @@ mod against_burn {
             let before = net.params.value.clone();
             // The engine: training forward (dropout on, batch statistics), backward of the MSE.
             net.reseed_dropout(42);
-            net.params.zero_grad();
-            let pred = net.forward(&x, batch, true).to_vec();
-            let n = y.len() as f32;
-            let dout: Vec<f32> = pred
-                .iter()
-                .zip(&y)
-                .map(|(p, t)| 2.0 * (p - t) / n)
-                .collect();
-            let loss: f64 = pred
-                .iter()
-                .zip(&y)
-                .map(|(p, t)| f64::from(p - t).powi(2))
-                .sum::<f64>()
-                / f64::from(n);
-            net.backward(&x, &dout);
+            let mut scratch = Vec::new();
+            let loss = Stepper::new(GradientEngine::Fused, &net.config)
+                .unwrap()
+                .step(&mut net, &x, &y, batch, &mut scratch)
+                .unwrap();
             let engine_grad = net.params.grad.clone();
             let engine_stats = net.params.value.clone();
             // burn: the same weights and the same dropout masks.
@@ -284,31 +275,28 @@ mod against_burn {
     fn training_steps_follow_the_same_trajectory() {
         // Ten Adam steps from the same start, gradients by each engine: the weights stay
         // together (float rounding only), so burn training is the engine's algorithm.
-        let device = Device::flex();
         for arch in ALL {
             let (batch, c, o) = (8, 4, 1);
             let (x, y) = data(batch, c, o);
             let mut fused = random_net(arch, c, o);
             let mut viaburn = random_net(arch, c, o);
-            let mut module = BurnNet::new(&viaburn.config, &device);
+            // The trainer's own steppers, as `train --engine fused|burn-cpu` runs them.
+            let mut by_engine = Stepper::new(GradientEngine::Fused, &fused.config).unwrap();
+            let mut by_burn = Stepper::new(GradientEngine::BurnCpu, &viaburn.config).unwrap();
             let (mut a1, mut a2) = (
                 Adam::new(fused.params.value.len(), 1e-3),
                 Adam::new(viaburn.params.value.len(), 1e-3),
             );
+            let mut scratch = Vec::new();
             for step in 0..10 {
                 fused.reseed_dropout(step);
-                fused.params.zero_grad();
-                let pred = fused.forward(&x, batch, true).to_vec();
-                let dout: Vec<f32> = pred
-                    .iter()
-                    .zip(&y)
-                    .map(|(p, t)| 2.0 * (p - t) / y.len() as f32)
-                    .collect();
-                fused.backward(&x, &dout);
+                by_engine
+                    .step(&mut fused, &x, &y, batch, &mut scratch)
+                    .unwrap();
                 a1.step(&mut fused.params);
                 viaburn.reseed_dropout(step);
-                module
-                    .gradients(&mut viaburn, &x, &y, batch, &device)
+                by_burn
+                    .step(&mut viaburn, &x, &y, batch, &mut scratch)
                     .unwrap();
                 a2.step(&mut viaburn.params);
             }
