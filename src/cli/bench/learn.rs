@@ -142,22 +142,36 @@ pub fn burn_table(engines: &[String], batches: &[usize], seconds: f64) -> anyhow
         "training with gradients by burn 0.22 (21 channels × 20 steps; weights upload and gradients read back every step, Adam in the engine)"
     );
     println!(
-        "{:<11} {:>6} {:<10} {:>12} {:>15} {:>10}",
-        "network", "batch", "engine", "train win/s", "fused win/s", "vs fused"
+        "{:<11} {:>6} {:<10} {:>12} {:>15} {:>10} {:>22}",
+        "network",
+        "batch",
+        "engine",
+        "train win/s",
+        "fused win/s",
+        "vs fused",
+        "PyTorch CPU (spec §5)"
     );
     for a in [A::CnnBiLstm, A::Cnn, A::BiLstm, A::Gru] {
         for &batch in batches {
             let fused = train_rate(a, GradientEngine::Fused, batch, seconds)?;
             for &engine in &engines {
                 let rate = train_rate(a, engine, batch, seconds)?;
+                // The spec's one-thread PyTorch figures are for batch 64 on a CPU.
+                let reference = if batch == 64 && engine == GradientEngine::BurnCpu {
+                    let r = pytorch_reference(a);
+                    format!("{r:.0} ({:.2}×)", rate / r)
+                } else {
+                    String::new()
+                };
                 println!(
-                    "{:<11} {:>6} {:<10} {:>12.0} {:>15.0} {:>9.2}×",
+                    "{:<11} {:>6} {:<10} {:>12.0} {:>15.0} {:>9.2}× {:>22}",
                     a.name(),
                     batch,
                     engine.name(),
                     rate,
                     fused,
-                    rate / fused
+                    rate / fused,
+                    reference
                 );
             }
         }
