@@ -15,10 +15,10 @@
 
 mod bridge;
 
+use super::gradient::GradientEngine;
 use super::neural::batch_norm::{EPS, MOMENTUM};
 use super::neural::network::{HEAD, HIDDEN, LEAKY, STEM_WIDTH};
 use super::neural::{Architecture, NetConfig, Network};
-use super::train::GradientEngine;
 use crate::error::{Error, Result};
 use ::burn::module::Module;
 use ::burn::nn::{

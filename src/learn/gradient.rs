@@ -1,0 +1,100 @@
+//! What computes a network's gradients in training: the hand-fused engine or burn's autodiff
+//! (`--features burn`). The trainer and `bench learn` run the same [`Stepper`].
+
+use super::neural::{NetConfig, Network};
+use crate::error::Result;
+use serde::{Deserialize, Serialize};
+
+/// What computes a network's forward and backward pass in training. The weights, Adam, the
+/// dropout stream, checkpoints and the model directory are the same for all: a model or a
+/// checkpoint of one engine loads (and resumes) in the other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GradientEngine {
+    /// The hand-fused engine (the fast CPU path).
+    #[default]
+    Fused,
+    /// burn's autodiff on its CPU backend (Flex); needs `--features burn`.
+    BurnCpu,
+    /// burn's autodiff on a GPU through wgpu and Vulkan; needs `--features burn-gpu`.
+    BurnGpu,
+}
+
+impl GradientEngine {
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            GradientEngine::Fused => "fused",
+            GradientEngine::BurnCpu => "burn-cpu",
+            GradientEngine::BurnGpu => "burn-gpu",
+        }
+    }
+}
+
+/// The gradient computation of one training step, by the chosen [`GradientEngine`]: what the
+/// trainer runs and `bench learn` times.
+pub enum Stepper {
+    /// The hand-fused engine.
+    Fused,
+    /// burn's autodiff on a device.
+    #[cfg(feature = "burn")]
+    Burn(Box<super::burn::BurnNet>, ::burn::tensor::Device),
+}
+
+impl Stepper {
+    /// The stepper of `engine` for networks of `config`; an error when this build lacks it.
+    pub fn new(engine: GradientEngine, config: &NetConfig) -> Result<Self> {
+        match engine {
+            GradientEngine::Fused => Ok(Stepper::Fused),
+            #[cfg(feature = "burn")]
+            burn => {
+                let device = super::burn::device(burn)?;
+                let net = super::burn::BurnNet::new(config, &device);
+                Ok(Stepper::Burn(Box::new(net), device))
+            }
+            #[cfg(not(feature = "burn"))]
+            other => {
+                let _ = config;
+                Err(crate::error::Error::Domain(format!(
+                    "--engine {} needs burn, and this railforce was built without it: rebuild with `cargo build --release --features {}`",
+                    other.name(),
+                    if other == GradientEngine::BurnGpu {
+                        "burn-gpu"
+                    } else {
+                        "burn"
+                    }
+                )))
+            }
+        }
+    }
+
+    /// Gradients of the mean squared error of `y` on `x` (`n` windows, training mode) into
+    /// `net.params.grad`, replacing them; returns the loss. `dout` is scratch space.
+    pub fn step(
+        &mut self,
+        net: &mut Network,
+        x: &[f32],
+        y: &[f32],
+        n: usize,
+        dout: &mut Vec<f32>,
+    ) -> Result<f64> {
+        match self {
+            Stepper::Fused => {
+                net.params.zero_grad();
+                let pred = net.forward(x, n, true);
+                dout.clear();
+                let scale = 2.0 / y.len() as f32;
+                let mut l = 0.0f64;
+                for (p, t) in pred.iter().zip(y.iter()) {
+                    let e = p - t;
+                    l += (e * e) as f64;
+                    dout.push(scale * e);
+                }
+                net.backward(x, dout);
+                Ok(l / y.len() as f64)
+            }
+            #[cfg(feature = "burn")]
+            Stepper::Burn(module, device) => Ok(module.gradients(net, x, y, n, device)?.loss),
+        }
+    }
+}
