@@ -264,6 +264,9 @@ mod against_burn {
             let mut module = BurnNet::new(&net.config, &device);
             module.load(&net, &device);
             let burn = module.predict(&x, 9, 20, &device).unwrap();
+            // Inputs that are not whole windows are refused, not a panic.
+            assert!(module.predict(&x, 0, 20, &device).is_err());
+            assert!(module.predict(&x[..100], 9, 20, &device).is_err());
             let scale = engine.iter().fold(1e-3f32, |m, v| m.max(v.abs()));
             for (a, b) in engine.iter().zip(&burn) {
                 assert!((a - b).abs() <= 1e-5 * scale, "{arch:?}: {a} vs {b}");

@@ -252,8 +252,14 @@ impl BurnNet {
 
     /// Evaluation-mode predictions `[B, outputs]` of `x[B, T, C]` in chunks of 1024 windows.
     pub fn predict(&self, x: &[f32], batch: usize, t: usize, device: &Device) -> Result<Vec<f32>> {
-        let per = x.len() / batch.max(1);
-        let c = per / t.max(1);
+        if batch == 0 || t == 0 || x.is_empty() || !x.len().is_multiple_of(batch * t) {
+            return Err(Error::Domain(format!(
+                "burn predict: {} inputs are not {batch} windows of {t} steps",
+                x.len()
+            )));
+        }
+        let per = x.len() / batch;
+        let c = per / t;
         let mut out = Vec::new();
         for chunk in x.chunks(per * 1024) {
             let n = chunk.len() / per;
