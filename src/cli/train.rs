@@ -109,8 +109,8 @@ pub struct TrainArgs {
     fixed_noise: bool,
     /// Networks: what computes each minibatch's forward and backward pass. `fused`, the
     /// hand-fused engine, is the fast CPU path; `burn-cpu` runs the same network as burn
-    /// modules with burn's autodiff (build with `--features burn`), `burn-gpu` on an NVIDIA GPU
-    /// (`--features burn-gpu`). Same weights, optimizer, dropout stream and model directory:
+    /// modules with burn's autodiff (build with `--features burn`), `burn-gpu` on a GPU through wgpu
+    /// and Vulkan (`--features burn-gpu`). Same weights, optimizer, dropout stream and model directory:
     /// a model or checkpoint of either engine loads and resumes in the other.
     #[arg(long, default_value = "fused", value_parser = ["fused", "burn-cpu", "burn-gpu"])]
     engine: String,
@@ -305,11 +305,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         } else {
             None
         },
-        engine: match args.engine.as_str() {
-            "burn-cpu" => GradientEngine::BurnCpu,
-            "burn-gpu" => GradientEngine::BurnGpu,
-            _ => GradientEngine::Fused,
-        },
+        engine: GradientEngine::from_name(&args.engine).unwrap_or_default(),
         ..TrainOptions::default()
     };
     let short = |t: &String| target_name(t, &ds.labels);
@@ -358,11 +354,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
             opts.windows_per_epoch
                 .map(|w| w.to_string())
                 .unwrap_or("all".into()),
-            match opts.engine {
-                GradientEngine::Fused => "the fused engine",
-                GradientEngine::BurnCpu => "burn (CPU, Flex backend)",
-                GradientEngine::BurnGpu => "burn (GPU, wgpu over Vulkan)",
-            }
+            opts.engine.describe()
         );
     } else {
         println!(

@@ -21,6 +21,27 @@ pub enum GradientEngine {
 }
 
 impl GradientEngine {
+    /// Every engine, in command-line order.
+    pub const ALL: [GradientEngine; 3] = [
+        GradientEngine::Fused,
+        GradientEngine::BurnCpu,
+        GradientEngine::BurnGpu,
+    ];
+
+    /// The engine of a command-line name (`fused`, `burn-cpu`, `burn-gpu`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|e| e.name() == name)
+    }
+
+    /// What it is, in words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            GradientEngine::Fused => "the fused engine",
+            GradientEngine::BurnCpu => "burn (CPU, Flex backend)",
+            GradientEngine::BurnGpu => "burn (GPU, wgpu over Vulkan)",
+        }
+    }
+
     /// Command-line name.
     pub fn name(self) -> &'static str {
         match self {
@@ -94,7 +115,7 @@ impl Stepper {
                 Ok(l / y.len() as f64)
             }
             #[cfg(feature = "burn")]
-            Stepper::Burn(module, device) => Ok(module.gradients(net, x, y, n, device)?.loss),
+            Stepper::Burn(module, device) => module.gradients(net, x, y, n, device),
         }
     }
 }

@@ -133,10 +133,7 @@ pub fn burn_table(engines: &[String], batches: &[usize], seconds: f64) -> anyhow
     use Architecture as A;
     let engines: Vec<GradientEngine> = engines
         .iter()
-        .map(|e| match e.as_str() {
-            "burn-gpu" => GradientEngine::BurnGpu,
-            _ => GradientEngine::BurnCpu,
-        })
+        .filter_map(|e| GradientEngine::from_name(e))
         .collect();
     println!(
         "training with gradients by burn 0.22 (21 channels × 20 steps; weights upload and gradients read back every step, Adam in the engine)"

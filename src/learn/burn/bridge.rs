@@ -37,6 +37,15 @@ impl Block {
         }
     }
 
+    /// `n` columns from `col` (rows `rows`, all when `None`).
+    fn columns(slot: String, rows: Option<(usize, usize)>, col: usize, n: usize) -> Self {
+        Block {
+            slot,
+            rows,
+            cols: Some((col, n)),
+        }
+    }
+
     /// `(first index, row stride, rows, columns)` of the block in the flat vector.
     fn locate(&self, slots: &[Slot]) -> Result<(usize, usize, usize, usize)> {
         let s = slots
@@ -113,41 +122,24 @@ fn gate(
     f: &mut Visit,
 ) -> Result<()> {
     let h = HIDDEN;
-    let cols = Some((col, h));
     let slot = |part: &str| format!("{name}.{part}");
     f(
         Target::Matrix(&mut g.input_transform.weight),
-        Block {
-            slot: slot("w_ih"),
-            rows: None,
-            cols,
-        },
+        Block::columns(slot("w_ih"), None, col, h),
     )?;
-    let bias = g.input_transform.bias.as_mut().expect("gates have biases");
+    let b_ih = g.input_transform.bias.as_mut().expect("gates have biases");
     f(
-        Target::Vector(bias),
-        Block {
-            slot: slot("b_ih"),
-            rows: None,
-            cols,
-        },
+        Target::Vector(b_ih),
+        Block::columns(slot("b_ih"), None, col, h),
     )?;
     f(
         Target::Matrix(&mut g.hidden_transform.weight),
-        Block {
-            slot: slot("w_hh"),
-            rows: hh_row.map(|r| (r, h)),
-            cols: Some((hh_col, h)),
-        },
+        Block::columns(slot("w_hh"), hh_row.map(|r| (r, h)), hh_col, h),
     )?;
-    let bias = g.hidden_transform.bias.as_mut().expect("gates have biases");
+    let b_hh = g.hidden_transform.bias.as_mut().expect("gates have biases");
     f(
-        Target::Vector(bias),
-        Block {
-            slot: slot("b_hh"),
-            rows: None,
-            cols,
-        },
+        Target::Vector(b_hh),
+        Block::columns(slot("b_hh"), None, col, h),
     )
 }
 

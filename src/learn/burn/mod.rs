@@ -16,8 +16,9 @@
 mod bridge;
 
 use super::gradient::GradientEngine;
+use super::linalg::LEAKY_SLOPE;
 use super::neural::batch_norm::{EPS, MOMENTUM};
-use super::neural::network::{HEAD, HIDDEN, LEAKY, STEM_WIDTH};
+use super::neural::network::{HEAD, HIDDEN, STEM_WIDTH};
 use super::neural::{Architecture, NetConfig, Network};
 use crate::error::{Error, Result};
 use ::burn::module::Module;
@@ -112,13 +113,6 @@ pub struct BurnNet {
     pub out: Linear,
 }
 
-/// What one burn training step reports.
-#[derive(Debug, Clone, Copy)]
-pub struct Step {
-    /// Mean squared error of the batch (standardised targets).
-    pub loss: f64,
-}
-
 impl BurnNet {
     /// The layers of `config` on `device` (burn's initial weights: call [`BurnNet::load`]).
     pub fn new(config: &NetConfig, device: &Device) -> Self {
@@ -162,7 +156,7 @@ impl BurnNet {
     /// are the head's inverted-dropout multipliers (`[B, F]` and `[B, 64]`), none in evaluation.
     pub fn forward(&self, x: Tensor<3>, masks: Option<[Tensor<2>; 2]>) -> Tensor<2> {
         let [b, t, _] = x.dims();
-        let slope = f64::from(LEAKY);
+        let slope = f64::from(LEAKY_SLOPE);
         let seq = match &self.stem {
             Some(stem) => {
                 let h = norm_rows(&stem.bn1, leaky_relu(stem.conv1.forward(x), slope));
@@ -210,7 +204,7 @@ impl BurnNet {
     /// have drawn the same), forward and backward in burn's autodiff on `device` (a plain
     /// device: autodiff is added here). Writes the gradients into `net.params.grad` (replacing
     /// them) and the batch-norm running statistics into `net.params.value` (PyTorch's unbiased
-    /// running variance, as the engine keeps it).
+    /// running variance, as the engine keeps it). Returns the batch's mean squared error.
     pub fn gradients(
         &mut self,
         net: &mut Network,
@@ -218,7 +212,7 @@ impl BurnNet {
         y: &[f32],
         batch: usize,
         device: &Device,
-    ) -> Result<Step> {
+    ) -> Result<f64> {
         let config = &net.config;
         let (t, c, o) = (config.window, config.channels, config.outputs);
         if x.len() != batch * t * c || y.len() != batch * o {
@@ -245,9 +239,7 @@ impl BurnNet {
         let grads = loss.backward();
         bridge::store_gradients(self, &grads, &mut net.params)?;
         bridge::store_running_stats(self, &mut net.params, batch * t)?;
-        Ok(Step {
-            loss: f64::from(value[0]),
-        })
+        Ok(f64::from(value[0]))
     }
 
     /// Evaluation-mode predictions `[B, outputs]` of `x[B, T, C]` in chunks of 1024 windows.

@@ -64,8 +64,6 @@ pub const STEM_WIDTH: usize = 128;
 pub const HIDDEN: usize = 20;
 /// Widths of the head's two hidden layers.
 pub const HEAD: [usize; 2] = [64, 8];
-/// Negative slope of every LeakyReLU.
-pub const LEAKY: f32 = LEAKY_SLOPE;
 
 struct Stem {
     c1: Dense,
