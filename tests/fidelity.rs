@@ -286,11 +286,10 @@ fn fidelity_checks_hold() {
         fidelity::yq_and_q(&base, 8).unwrap(),
         fidelity::yq_and_q(&fine, 8).unwrap(),
     );
-    // Every wheel within 1 % (issue 17). Measured with the track files' 243 kg lateral rail
-    // mass: leading 0.5 %, trailing 0.4 %; with the former 150 kg the trailing ones were 2.85 %
-    // off (a rail mode the explicit step followed poorly; README).
+    // Every wheel within 1 % (issue 17). Measured: leading 0.40 %, trailing 0.32 %; with the
+    // former 150 kg lateral rail mass the trailing ones were 2.85 % off (README).
+    let tol = 0.01;
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
-        let tol = 0.01;
         assert!(
             (x.0 / y.0 - 1.0).abs() < tol,
             "wheel {k}: Y/Q rms {} vs {}",
