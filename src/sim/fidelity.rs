@@ -32,6 +32,28 @@ pub struct CriticalSpeed {
     pub blocks: Vec<(f64, f64)>,
 }
 
+/// A run that starts 6 mm off the centre line (the kink) at `speed`, without settling, and
+/// stops on derailment.
+fn kinked<'a>(
+    vehicle: &'a Vehicle,
+    track: &'a Track,
+    speed: f64,
+    duration: f64,
+) -> Result<Simulation<'a>> {
+    Simulation::new(
+        vehicle,
+        track,
+        SimConfig {
+            speed,
+            duration,
+            settle: 0.0,
+            initial_offset: 6e-3,
+            stop_on_derailment: true,
+            ..SimConfig::default()
+        },
+    )
+}
+
 /// Runs the kink-and-coast test of `vehicle` on the smooth `track`.
 pub fn critical_speed(
     vehicle: &Vehicle,
@@ -42,15 +64,7 @@ pub fn critical_speed(
 ) -> Result<CriticalSpeed> {
     let hold = 5.0;
     let duration = hold + (from - to) / decel + 2.0;
-    let cfg = SimConfig {
-        speed: from,
-        duration,
-        settle: 0.0,
-        initial_offset: 6e-3,
-        stop_on_derailment: true,
-        ..SimConfig::default()
-    };
-    let mut sim = Simulation::new(vehicle, track, cfg)?;
+    let mut sim = kinked(vehicle, track, from, duration)?;
     let lead = 0;
     let steps_per_block = (1.0 / sim.config().dt).round() as usize;
     let mut blocks = Vec::new();
@@ -117,15 +131,7 @@ pub fn settled(
     duration: f64,
     tail: f64,
 ) -> Result<Settled> {
-    let cfg = SimConfig {
-        speed,
-        duration,
-        settle: 0.0,
-        initial_offset: 6e-3,
-        stop_on_derailment: true,
-        ..SimConfig::default()
-    };
-    let mut sim = Simulation::new(vehicle, track, cfg)?;
+    let mut sim = kinked(vehicle, track, speed, duration)?;
     let heaviest = (0..vehicle.bodies.len())
         .max_by(|&a, &b| vehicle.bodies[a].mass.total_cmp(&vehicle.bodies[b].mass))
         .unwrap_or(0);
