@@ -31,8 +31,8 @@ pub(crate) use spring_nest::SpringNestFile;
 pub(crate) use track_spring::TrackSpringFile;
 pub(crate) use wedge_damper::WedgeDamperFile;
 
-/// Internal state of an element that has one (the friction sliders of wedges, centre plates and
-/// side bearers), zero at the static position; the simulation keeps one per element.
+/// Internal state of an element that has one (the sliders of a wedge), zero at the static
+/// position; the simulation keeps one per element.
 pub type Memory = [f64; 4];
 
 use super::body::{Attachment, BodyState, Wrench};
@@ -69,8 +69,8 @@ impl Element {
             Element::SpringNest(e) => e.apply(states, wrenches),
             Element::WedgeDamper(e) => e.apply(states, memory, wrenches),
             Element::LateralStop(e) => e.apply(states, wrenches),
-            Element::CentrePlate(e) => e.apply(states, memory, wrenches),
-            Element::SideBearer(e) => e.apply(states, memory, wrenches),
+            Element::CentrePlate(e) => e.apply(states, wrenches),
+            Element::SideBearer(e) => e.apply(states, wrenches),
             Element::CrossBracing(e) => e.apply(states, wrenches),
             // Needs the track frame: applied by the simulation (see `Simulation::step`).
             Element::TrackSpring(_) => {}
@@ -192,5 +192,16 @@ impl Relative {
         let f = self.axes * f_upper_local;
         wrenches[upper.body].add_at(f, self.p_upper, states[upper.body].position);
         wrenches[lower.body].add_at(-f, self.p_lower, states[lower.body].position);
+    }
+}
+
+/// Smooth friction direction factor `tanh(|v|/v_ref)·v/|v|` (a regularised sign, spec §2).
+#[inline]
+pub(crate) fn friction_dir(v: Vector3<f64>, v_ref: f64) -> Vector3<f64> {
+    let n = v.norm();
+    if n < 1e-12 {
+        Vector3::zeros()
+    } else {
+        v * ((n / v_ref).tanh() / n)
     }
 }

@@ -1,12 +1,4 @@
-//! Axle-box rubber shear pad: linear spring–damper in three directions, and the pad's
-//! resistance to the side frame rolling on it.
-//!
-//! A pad of lateral width `w` is a bed of vertical springs under the pedestal roof: rolling
-//! the side frame by θ on it takes `M = k_z·w²/12·θ` (the bed's second moment, k_z spread
-//! evenly over the width), damped alike (`c_z·w²/12`), until the compressed edge carries the
-//! whole load and the roof tips on it: |M| ≤ N·w/2 with N the pad's current vertical force.
-//! With `w = 0` the pad is a point spring and the side frame rolls freely about the line of
-//! its two pads.
+//! Axle-box rubber shear pad: linear spring–damper in three directions.
 
 use super::Relative;
 use crate::error::Result;
@@ -28,8 +20,6 @@ pub struct ShearPad {
     pub damping: Vector3<f64>,
     /// Static vertical load carried, N.
     pub preload: f64,
-    /// Lateral width of the pad under the pedestal roof, m (0: no roll resistance).
-    pub width: f64,
 }
 
 impl ShearPad {
@@ -39,34 +29,6 @@ impl ShearPad {
             + self.damping.component_mul(&r.v)
             + Vector3::new(0.0, 0.0, self.preload);
         r.apply(f, &self.upper, &self.lower, states, wrenches);
-        if self.width > 0.0 {
-            let (su, sl) = (&states[self.upper.body], &states[self.lower.body]);
-            // The axle's direction in the side frame's axes gives their relative roll θ,
-            // independent of the wheelset's spin about that axis.
-            let axle = sl.matrix().column(1).into_owned();
-            let a = r.axes.transpose() * axle;
-            let theta = (-a.z).atan2(a.y);
-            let w_lower = sl.angular_velocity - axle * sl.angular_velocity.dot(&axle);
-            let x_upper = r.axes.column(0).into_owned();
-            let theta_dot = (su.angular_velocity - w_lower).dot(&x_upper);
-            let m = self.rocking_moment(theta, theta_dot, f.z);
-            wrenches[self.upper.body].torque -= x_upper * m;
-            wrenches[self.lower.body].torque += x_upper * m;
-        }
-    }
-
-    /// Rolling moment the pad's width resists with, per radian of relative roll, N·m/rad.
-    pub fn rocking_stiffness(&self) -> f64 {
-        self.stiffness.z * self.width * self.width / 12.0
-    }
-
-    /// Moment (N·m) resisting the side frame's roll `theta` (rad) relative to the axle at the
-    /// rate `theta_dot` (rad/s) with the pad carrying `normal` (N): the spring bed's
-    /// `(k_z·θ + c_z·θ̇)·w²/12`, no more than the load tipping on an edge, `N·w/2`.
-    pub fn rocking_moment(&self, theta: f64, theta_dot: f64, normal: f64) -> f64 {
-        let tip = 0.5 * self.width * normal.max(0.0);
-        (self.width * self.width / 12.0 * (self.stiffness.z * theta + self.damping.z * theta_dot))
-            .clamp(-tip, tip)
     }
 }
 
@@ -80,16 +42,12 @@ pub(crate) struct ShearPadFile {
     stiffness: [f64; 3],
     #[serde(default)]
     damping: [f64; 3],
-    /// Lateral width of the pad, m (0 or absent: a point spring).
-    #[serde(default)]
-    width_m: f64,
 }
 
 impl ShearPad {
     pub(crate) fn bind(f: &str, e: &ShearPadFile, b: &Binder) -> Result<Self> {
         b.non_negative(format!("{f}.stiffness"), &e.stiffness)?;
         b.non_negative(format!("{f}.damping"), &e.damping)?;
-        b.non_negative(format!("{f}.width_m"), &[e.width_m])?;
         let (upper, lower) = b.pair(f, &e.upper, &e.lower, e.at)?;
         Ok(ShearPad {
             upper,
@@ -97,7 +55,6 @@ impl ShearPad {
             stiffness: Vector3::from(e.stiffness),
             damping: Vector3::from(e.damping),
             preload: 0.0,
-            width: e.width_m,
         })
     }
 }
