@@ -181,6 +181,35 @@ fn s1002_on_60kg_conicity_grows_toward_flange_contact() {
     }
 }
 
+#[test]
+fn flange_back_sets_the_s1002_conicity() {
+    // S1002 is drawn for a 1 360 mm flange back; at the Chinese 1 353 mm each wheel sits
+    // 3.5 mm further out on its nearly flat tread, so the new-profile pair is almost
+    // cylindrical (README, validate dynamics: the hunting order depends on it).
+    let conicity = |back: f64| {
+        let geo = WheelsetGeometry::new(
+            profile::s1002(),
+            profile::rail_60kg(),
+            (1.0f64 / 40.0).atan(),
+            1.435,
+            back,
+            0.07,
+            0.42,
+        )
+        .unwrap();
+        geo.table(12e-3, 2e-4).equivalent_conicity(3e-3).unwrap()
+    };
+    let (chinese, design) = (conicity(1.353), conicity(1.360));
+    assert!(
+        chinese > 0.01 && chinese < 0.03,
+        "λe(3 mm) at 1 353 mm: {chinese}"
+    );
+    assert!(
+        design > 0.12 && design < 0.25,
+        "λe(3 mm) at 1 360 mm: {design}"
+    );
+}
+
 fn write(name: &str, text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("railforce-prof-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -267,6 +267,14 @@ fn fidelity(
     ))?)?;
     let e = railforce::vehicle::Vehicle::load(&super::builtin::resolve(empty)?)?;
     let (from, to) = (150.0 / 3.6, 50.0 / 3.6);
+    // Hunting depends first on the wheel–rail pair's equivalent conicity: say which one ran.
+    match v.contact.table().equivalent_conicity(0.003) {
+        Some(l) => println!(
+            "  wheel–rail pair of {}: equivalent conicity {l:.4} at 3 mm amplitude (EN 15302)",
+            v.name
+        ),
+        None => println!("  equivalent conicity at 3 mm: not defined for this profile pair"),
+    }
     let mut found = Vec::new();
     for w in [v, &e] {
         let c = fd::critical_speed(w, &smooth, from, to, 1.0)?;
