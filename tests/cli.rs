@@ -339,6 +339,50 @@ fn built_in_vehicles_and_tracks_work_from_an_empty_folder() {
     assert!(ok, "{out}\n{err}");
     assert!(err.contains("built-in"), "{err}");
     assert!(dir.join("run.csv").exists());
+    // The extension picks the format: the same run in Parquet holds the CSV's numbers; an
+    // unknown extension is refused before anything runs or is written.
+    let (ok, out, err) = run(&[
+        "simulate",
+        "--track",
+        "tangent",
+        "--duration",
+        "0.2",
+        "--settle",
+        "0.1",
+        "--out",
+        "run.parquet",
+    ]);
+    assert!(ok, "{out}\n{err}");
+    let cols = railforce::dataset::parquet_file::read_parquet(
+        std::fs::read(dir.join("run.parquet")).unwrap(),
+    )
+    .unwrap();
+    let csv = std::fs::read_to_string(dir.join("run.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let q = header.iter().position(|h| *h == "w1l_force_z").unwrap();
+    let last: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(q)
+        .unwrap()
+        .parse()
+        .unwrap();
+    let (name, values) = &cols[q];
+    assert_eq!(name, "w1l_force_z");
+    assert_eq!(values.len(), csv.lines().count() - 1);
+    assert!(
+        (values.last().unwrap() - last).abs() <= 1e-6 * last.abs(),
+        "{last}"
+    );
+    assert!(dir.join("run.meta.json").exists());
+    let (ok, _, err) = run(&["simulate", "--track", "tangent", "--out", "run.txt"]);
+    assert!(
+        !ok && err.contains("run.txt") && err.contains(".parquet"),
+        "{err}"
+    );
+    assert!(!dir.join("run.txt").exists());
     // A bare name stands for a built-in track, vehicle or plan.
     let (ok, out, err) = run(&["track", "curve_r400"]);
     assert!(ok && out.contains("R 400 m"), "{out}\n{err}");

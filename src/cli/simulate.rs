@@ -3,6 +3,7 @@
 use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use railforce::dataset::{Format, write_run};
 use railforce::sim::{SimConfig, Simulation, output, wheel_name};
 use railforce::track::{Track, TrackSpec};
 use railforce::vehicle::Vehicle;
@@ -25,7 +26,8 @@ pub struct SimulateArgs {
     /// Irregularity seed (overrides the track file's).
     #[arg(long)]
     seed: Option<u64>,
-    /// Output CSV (a `.meta.json` file is written beside it).
+    /// Output file, its format by its extension: `.csv`, `.parquet` (what `generate` writes) or
+    /// `.npz`; a `.meta.json` file is written beside it.
     #[arg(long, default_value = "run.csv")]
     out: PathBuf,
     /// Settling time before recording, s (not written out).
@@ -49,6 +51,17 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     if args.settle.is_nan() || args.settle < 0.0 {
         bail!("--settle must not be negative, got {}", args.settle);
     }
+    let format = args
+        .out
+        .extension()
+        .and_then(|e| e.to_str())
+        .and_then(|e| Format::parse(&e.to_ascii_lowercase()));
+    let Some(format) = format else {
+        bail!(
+            "--out {}: the extension names the format; use .csv, .parquet or .npz",
+            args.out.display()
+        );
+    };
     let mut args = args;
     args.vehicle = super::builtin::resolve(&args.vehicle)?;
     args.track = super::builtin::resolve(&args.track)?;
@@ -92,9 +105,14 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         args.duration,
         track.spec().name
     ));
-    let summary = output::run_to_csv(&mut sim, &args.out, &meta, |f| {
-        bar.set_position((f * 1000.0) as u64)
-    });
+    let progress = |f: f64| bar.set_position((f * 1000.0) as u64);
+    let summary = match format {
+        Format::Csv => output::run_to_csv(&mut sim, &args.out, &meta, progress),
+        _ => output::record(&mut sim, progress).and_then(|rec| {
+            write_run(&args.out, &rec, format, false)?;
+            output::write_meta(&args.out, &meta, &rec)
+        }),
+    };
     bar.finish_and_clear();
     let summary = summary?;
     println!(

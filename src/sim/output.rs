@@ -379,6 +379,16 @@ pub fn run_to_csv(
 ) -> Result<RunSummary> {
     let recording = record(sim, progress)?;
     crate::io::write_atomic(out, |w| recording.write_csv(w))?;
+    write_meta(out, meta, &recording)
+}
+
+/// Writes `<out>.meta.json` for a recording written to `out`: `meta` with the channels (name,
+/// unit), the row count and the wall time added; returns the run's summary naming `out`.
+pub fn write_meta(
+    out: &Path,
+    meta: &serde_json::Value,
+    recording: &Recording,
+) -> Result<RunSummary> {
     let mut meta = meta.clone();
     if let Some(m) = meta.as_object_mut() {
         m.insert(
@@ -397,7 +407,7 @@ pub fn run_to_csv(
         serde_json::to_writer_pretty(&mut *w, &meta).map_err(std::io::Error::other)?;
         w.write_all(b"\n")
     })?;
-    let mut summary = recording.summary;
+    let mut summary = recording.summary.clone();
     summary.out = out.to_path_buf();
     Ok(summary)
 }
