@@ -121,6 +121,12 @@ fn bad_track_file_fails_with_file_and_field() {
     );
     let (ok, _, err) = railforce(&["track", "no/such/file.toml"]);
     assert!(!ok && err.contains("no/such/file.toml"), "{err}");
+    // A bare name that is neither a file nor a built-in says which names are built in.
+    let (ok, _, err) = railforce(&["track", "curve_r401"]);
+    assert!(
+        !ok && err.contains("curve_r401") && err.contains("curve_r400, "),
+        "{err}"
+    );
 }
 
 #[test]

@@ -163,6 +163,17 @@ pub fn resolve(path: &Path) -> Result<PathBuf> {
             .into_iter()
             .find(|c| FILES.iter().any(|(p, _)| p == c))
         });
+    if named.is_none()
+        && rel
+            .to_str()
+            .is_some_and(|r| !r.contains('/') && !r.contains('.'))
+    {
+        anyhow::bail!(
+            "{}: no such file, and no built-in plan, vehicle or track of that name (built-in: {})",
+            path.display(),
+            builtin_names().join(", ")
+        );
+    }
     let rel = named.as_deref().map(Path::new).unwrap_or(rel);
     let Some(rel) = rel.to_str().filter(|r| FILES.iter().any(|(p, _)| p == r)) else {
         return Ok(path.to_path_buf());
@@ -185,6 +196,30 @@ pub fn resolve(path: &Path) -> Result<PathBuf> {
         dir.join(rel).display()
     );
     Ok(dir.join(rel))
+}
+
+/// The bare names that stand for built-in plans, vehicles and tracks, in that order.
+fn builtin_names() -> Vec<&'static str> {
+    let (mut plans, mut vehicles, mut tracks) = (Vec::new(), Vec::new(), Vec::new());
+    for (p, _) in FILES {
+        if let Some(n) = p
+            .strip_prefix("tracks/")
+            .and_then(|n| n.strip_suffix(".plan.toml"))
+        {
+            plans.push(n);
+        } else if let Some(n) = p
+            .strip_prefix("vehicles/")
+            .and_then(|n| n.strip_suffix(".toml"))
+        {
+            vehicles.push(n);
+        } else if let Some(n) = p
+            .strip_prefix("tracks/")
+            .and_then(|n| n.strip_suffix(".toml"))
+        {
+            tracks.push(n);
+        }
+    }
+    [plans, vehicles, tracks].concat()
 }
 
 /// Writes every built-in file under `dir` (the repository's layout); refuses to overwrite an
