@@ -172,6 +172,18 @@ fn a_run_without_the_channels_is_refused_by_name() {
         "{err}"
     );
     assert!(!f.with_file_name("sensors_only.view.html").exists());
+    // A run that is not there is named as missing, not as lacking metadata.
+    let missing = tmp("not_there.csv");
+    let out = Command::new(env!("CARGO_BIN_EXE_railforce"))
+        .args(["view", missing.to_str().unwrap()])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("not_there.csv: no such run file"),
+        "{err}"
+    );
 }
 
 /// Chromium (or Chrome) on this machine, if any: `RAILFORCE_BROWSER` or the usual names.

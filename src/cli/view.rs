@@ -108,6 +108,9 @@ fn build(
     if !(src.rate_hz.is_finite() && src.rate_hz > 0.0) {
         bail!("--rate-hz {}: give a positive rate", src.rate_hz);
     }
+    if !run.is_file() {
+        bail!("{}: no such run file", run.display());
+    }
     let meta = run_meta(run);
     let vehicle_path = match (src.vehicle, &meta.vehicle) {
         (Some(p), _) => super::builtin::resolve(p)?,
