@@ -156,8 +156,8 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// Reads and validates a plan file (the track files themselves are checked by
-    /// [`crate::track::TrackSpec::load`] when used).
+    /// Reads and validates a plan file: its fields, then that every vehicle and track file it
+    /// names exists (their contents are checked by their own loaders when used).
     pub fn load(path: &Path) -> Result<Self> {
         let raw: PlanFile = crate::io::read_toml(path)?;
         let dir = path.parent().unwrap_or(Path::new("."));
@@ -268,6 +268,30 @@ impl Plan {
                 start_m: c.start_m,
             });
         }
+        // Every file the plan names must be there now, not when its run comes up (checked last,
+        // so a malformed plan is told what is malformed first).
+        let vehicle = dir.join(&raw.vehicle);
+        let missing = |field: String, p: &Path| {
+            Error::config(
+                path,
+                field,
+                format!(
+                    "{} is not a file (paths are relative to the plan file)",
+                    p.display()
+                ),
+            )
+        };
+        if !vehicle.is_file() {
+            return Err(missing("vehicle".into(), &vehicle));
+        }
+        for (i, c) in conditions.iter().enumerate() {
+            if !c.track.is_file() {
+                return Err(missing(format!("condition[{i}].track"), &c.track));
+            }
+            if !c.vehicle.is_file() {
+                return Err(missing(format!("condition[{i}].vehicle"), &c.vehicle));
+            }
+        }
         Ok(Plan {
             source: path.to_path_buf(),
             name: raw.name.unwrap_or_else(|| {
@@ -275,7 +299,7 @@ impl Plan {
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_default()
             }),
-            vehicle: dir.join(raw.vehicle),
+            vehicle,
             conditions,
             dataset,
         })

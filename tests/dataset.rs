@@ -302,6 +302,19 @@ fn plan_keys_are_read_and_bad_ones_named() {
             format!("{head}[dataset]\nchannels = [\"\"]\n{cond}"),
             "dataset.channels",
         ),
+        // Files that are not there are named with the key that names them.
+        (
+            format!(
+                "{head}{}",
+                cond.replace("curve_r400.toml", "curve_r401.toml")
+            ),
+            "condition[0].track: ",
+        ),
+        (head.replace("c80.toml", "c81.toml") + &cond, "vehicle: "),
+        (
+            format!("{head}{cond}vehicle = \"nowhere.toml\"\n"),
+            "condition[0].vehicle: ",
+        ),
     ] {
         let err = Plan::load(&write(&bad)).unwrap_err().to_string();
         assert!(
