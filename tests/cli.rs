@@ -475,6 +475,24 @@ fn identify_both_wheels_streaming_equals_batch() {
         !ok && err.contains("unknown target FX") && err.contains("w1l"),
         "{err}"
     );
+    // A finished model is not trained over by a repeated command.
+    let before = std::fs::read(model.join("weights.bin")).unwrap();
+    let (ok, _, err) = railforce(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        "gru",
+        "--target",
+        "w1l,1R",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("--force") && err.contains("--resume"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(model.join("weights.bin")).unwrap(), before);
     let input = data.join("curve_r400_seed3.csv");
     let batch = tmp("wheels_batch.csv");
     let (ok, _, err) = railforce(&[

@@ -101,6 +101,10 @@ pub struct TrainArgs {
     /// Continue from the checkpoint in --out (same data and settings).
     #[arg(long)]
     resume: bool,
+    /// Train anew into an --out that already holds a model or a checkpoint (without it, and
+    /// without --resume, such a folder is refused so that no finished training is lost).
+    #[arg(long, conflicts_with = "resume")]
+    force: bool,
     /// Networks, matched protocol: learn the data set's one fixed noise realisation instead of
     /// drawing new training-input noise every epoch at its SNR (the default, the spec's and
     /// the experiments' protocol; validation and test always keep the data set's noisy
@@ -361,6 +365,19 @@ pub fn run(args: TrainArgs) -> Result<()> {
             "  fitted on at most {} training windows (evenly strided)",
             opts.classical_rows
         );
+    }
+    if !args.resume && !args.force {
+        for (file, what) in [
+            ("model.json", "a trained model"),
+            ("checkpoint.json", "a checkpoint"),
+        ] {
+            if args.out.join(file).exists() {
+                bail!(
+                    "{} already holds {what} ({file}): --resume continues it, --force trains anew over it, or give another --out",
+                    args.out.display()
+                );
+            }
+        }
     }
     let model = train_with_bar(&ds, &spec, kind, &opts, &args.out)?;
     let t = &model.meta.training;
