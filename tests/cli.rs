@@ -574,6 +574,21 @@ fn identify_both_wheels_streaming_equals_batch() {
     for e in [&err_batch, &err_stream.to_string()] {
         assert!(e.contains("column frame_l_acc_y_noisy, row 5"), "{e}");
     }
+    // …and so is an empty field, which the CSV reader itself refuses.
+    f[k] = String::new();
+    lines[5] = f.join(",");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    let (ok, _, err) = railforce(&[
+        "identify",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        bad.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("column frame_l_acc_y_noisy, row 5: \"\" is not a number"),
+        "{err}"
+    );
 }
 
 /// `contact` rolls by default (no longitudinal force when centred), prints Y/Q, warns past

@@ -315,7 +315,15 @@ pub fn read_csv(bytes: &[u8], file: &Path) -> Result<Vec<(String, Vec<f64>)>> {
         for (k, v) in line.split(',').enumerate() {
             let x: f64 = v.parse().map_err(|_| Error::Parse {
                 file: file.to_path_buf(),
-                message: format!("row {}, column {}: not a number", ln + 2, k + 1),
+                // The same wording as the identify checks: column, row from 1 after the header.
+                message: format!(
+                    "column {}, row {}: \"{v}\" is not a number",
+                    header
+                        .get(k)
+                        .map(String::as_str)
+                        .unwrap_or("(beyond the header)"),
+                    ln + 1
+                ),
             })?;
             cols.get_mut(k)
                 .ok_or_else(|| Error::Parse {
