@@ -446,48 +446,31 @@ fn demo_runs_from_an_empty_folder() {
 fn identify_both_wheels_streaming_equals_batch() {
     let data = tiny_data("wheels", "curve_r400", 0.5, "csv");
     let model = tmp("wheels_model");
-    let (ok, _, err) = railforce(&[
-        "train",
-        "--data",
-        data.to_str().unwrap(),
-        "--model",
-        "gru",
-        "--epochs",
-        "1",
-        "--target",
-        "w1l,1R",
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let train = |target: &str| {
+        railforce(&[
+            "train",
+            "--data",
+            data.to_str().unwrap(),
+            "--model",
+            "gru",
+            "--epochs",
+            "1",
+            "--target",
+            target,
+            "--out",
+            model.to_str().unwrap(),
+        ])
+    };
+    let (ok, _, err) = train("w1l,1R");
     assert!(ok, "{err}");
-    let (ok, _, err) = railforce(&[
-        "train",
-        "--data",
-        data.to_str().unwrap(),
-        "--model",
-        "gru",
-        "--target",
-        "FX",
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let (ok, _, err) = train("FX");
     assert!(
         !ok && err.contains("unknown target FX") && err.contains("w1l"),
         "{err}"
     );
     // A finished model is not trained over by a repeated command.
     let before = std::fs::read(model.join("weights.bin")).unwrap();
-    let (ok, _, err) = railforce(&[
-        "train",
-        "--data",
-        data.to_str().unwrap(),
-        "--model",
-        "gru",
-        "--target",
-        "w1l,1R",
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let (ok, _, err) = train("w1l,1R");
     assert!(
         !ok && err.contains("--force") && err.contains("--resume"),
         "{err}"
