@@ -198,28 +198,19 @@ pub fn resolve(path: &Path) -> Result<PathBuf> {
     Ok(dir.join(rel))
 }
 
-/// The bare names that stand for built-in plans, vehicles and tracks, in that order.
+/// The bare names that stand for built-in plans, vehicles and tracks, in that order (the
+/// names `resolve` accepts: no dot, so a plan is not also listed as a track).
 fn builtin_names() -> Vec<&'static str> {
-    let (mut plans, mut vehicles, mut tracks) = (Vec::new(), Vec::new(), Vec::new());
-    for (p, _) in FILES {
-        if let Some(n) = p
-            .strip_prefix("tracks/")
-            .and_then(|n| n.strip_suffix(".plan.toml"))
-        {
-            plans.push(n);
-        } else if let Some(n) = p
-            .strip_prefix("vehicles/")
-            .and_then(|n| n.strip_suffix(".toml"))
-        {
-            vehicles.push(n);
-        } else if let Some(n) = p
-            .strip_prefix("tracks/")
-            .and_then(|n| n.strip_suffix(".toml"))
-        {
-            tracks.push(n);
-        }
-    }
-    [plans, vehicles, tracks].concat()
+    let kind = |prefix: &'static str, suffix: &'static str| {
+        FILES
+            .iter()
+            .filter_map(move |(p, _)| p.strip_prefix(prefix)?.strip_suffix(suffix))
+            .filter(|n| !n.contains('.'))
+    };
+    kind("tracks/", ".plan.toml")
+        .chain(kind("vehicles/", ".toml"))
+        .chain(kind("tracks/", ".toml"))
+        .collect()
 }
 
 /// Writes every built-in file under `dir` (the repository's layout); refuses to overwrite an

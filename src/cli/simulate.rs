@@ -106,13 +106,11 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         track.spec().name
     ));
     let progress = |f: f64| bar.set_position((f * 1000.0) as u64);
-    let summary = match format {
-        Format::Csv => output::run_to_csv(&mut sim, &args.out, &meta, progress),
-        _ => output::record(&mut sim, progress).and_then(|rec| {
-            write_run(&args.out, &rec, format, false)?;
-            output::write_meta(&args.out, &meta, &rec)
-        }),
-    };
+    // One writer for every format, the data sets' (CSV bytes as `run_to_csv` writes them).
+    let summary = output::record(&mut sim, progress).and_then(|rec| {
+        write_run(&args.out, &rec, format, false)?;
+        output::write_meta(&args.out, &meta, &rec)
+    });
     bar.finish_and_clear();
     let summary = summary?;
     println!(
