@@ -15,6 +15,16 @@ pub struct Body {
     pub position: Vector3<f64>,
 }
 
+impl Body {
+    /// Half-lengths (x, y, z) of the uniform box with this body's mass and principal inertias,
+    /// m: `L_x² = 6·(I_y + I_z − I_x)/m` and alike (a rough size for checking attachment points).
+    pub fn half_extents(&self) -> Vector3<f64> {
+        let i = self.inertia;
+        let l = |a: f64, b: f64, c: f64| 0.5 * (6.0 * (b + c - a).max(0.0) / self.mass).sqrt();
+        Vector3::new(l(i.x, i.y, i.z), l(i.y, i.z, i.x), l(i.z, i.x, i.y))
+    }
+}
+
 /// Position, orientation and velocities of a body in the world frame (x, y horizontal, z up).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyState {

@@ -16,6 +16,8 @@ pub struct LateralStop {
     pub upper: Attachment,
     /// Side frame column.
     pub lower: Attachment,
+    /// Static offset of the lower point from the upper (`lower_at − upper_at`), m.
+    pub rest: Vector3<f64>,
     /// Free play each way from the static position, m.
     pub clearance: f64,
     /// Contact stiffness, N/m.
@@ -39,7 +41,7 @@ impl LateralStop {
     }
 
     pub(crate) fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
-        let r = Relative::new(&self.upper, &self.lower, states);
+        let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         let fy = self.force(r.d.y, r.v.y);
         if fy != 0.0 {
             r.apply(
@@ -59,7 +61,12 @@ impl LateralStop {
 pub(crate) struct LateralStopFile {
     upper: String,
     lower: String,
-    at: [f64; 3],
+    /// Refused: one point for both bodies (see `Binder::pair`).
+    at: Option<[f64; 3]>,
+    /// Where the element meets the upper body, vehicle frame, m.
+    upper_at: Option<[f64; 3]>,
+    /// Where the element meets the lower body, vehicle frame, m.
+    lower_at: Option<[f64; 3]>,
     clearance_m: f64,
     stiffness: f64,
     #[serde(default)]
@@ -71,10 +78,12 @@ impl LateralStop {
         b.non_negative(format!("{f}.clearance_m"), &[e.clearance_m])?;
         b.positive(format!("{f}.stiffness"), e.stiffness)?;
         b.non_negative(format!("{f}.damping"), &[e.damping])?;
-        let (upper, lower) = b.pair(f, &e.upper, &e.lower, e.at)?;
+        let (upper, lower, rest) =
+            b.pair(f, (&e.upper, &e.lower), e.at, (e.upper_at, e.lower_at))?;
         Ok(LateralStop {
             upper,
             lower,
+            rest,
             clearance: e.clearance_m,
             stiffness: e.stiffness,
             damping: e.damping,

@@ -1,8 +1,15 @@
 //! Force elements of the suspension, one file per kind. Each acts between two bodies through
-//! attachment points and adds equal and opposite forces (and torques) to their wrenches. Axes of
-//! an element are those of its upper body; displacements are those of the lower attachment
-//! relative to the upper one, zero in the static loaded position, where supporting elements
-//! carry their preload.
+//! an attachment point on each (`upper_at`, `lower_at`: where the parts meet, not one point for
+//! both) and adds equal and opposite forces (and torques) to their wrenches. Axes of an element
+//! are those of its upper body; displacements are those of the lower attachment relative to
+//! the upper one less their static offset, zero in the static loaded position, where
+//! supporting elements carry their preload.
+//!
+//! Each body takes the element's force at its own point. The two points are not on one line of
+//! action, so the pair of forces has a couple `(p_lower − p_upper) × F`; the upper body carries
+//! it (as the clamped top of a coil spring carries its shear couple), so the lower body feels
+//! the force exactly where it meets the element: a side frame loaded at its spring seat and
+//! carried at its pedestal roofs hangs, as built (spec physics.md §2).
 
 mod centre_plate;
 mod cross_bracing;
@@ -31,8 +38,8 @@ pub(crate) use spring_nest::SpringNestFile;
 pub(crate) use track_spring::TrackSpringFile;
 pub(crate) use wedge_damper::WedgeDamperFile;
 
-/// Internal state of an element that has one (the sliders of a wedge), zero at the static
-/// position; the simulation keeps one per element.
+/// Internal state of an element that has one (the friction sliders of wedges, centre plates and
+/// side bearers), zero at the static position; the simulation keeps one per element.
 pub type Memory = [f64; 4];
 
 use super::body::{Attachment, BodyState, Wrench};
@@ -69,8 +76,8 @@ impl Element {
             Element::SpringNest(e) => e.apply(states, wrenches),
             Element::WedgeDamper(e) => e.apply(states, memory, wrenches),
             Element::LateralStop(e) => e.apply(states, wrenches),
-            Element::CentrePlate(e) => e.apply(states, wrenches),
-            Element::SideBearer(e) => e.apply(states, wrenches),
+            Element::CentrePlate(e) => e.apply(states, memory, wrenches),
+            Element::SideBearer(e) => e.apply(states, memory, wrenches),
             Element::CrossBracing(e) => e.apply(states, wrenches),
             // Needs the track frame: applied by the simulation (see `Simulation::step`).
             Element::TrackSpring(_) => {}
@@ -81,8 +88,13 @@ impl Element {
     /// body's axes (lower attachment relative to the upper: `+z` compresses a supporting
     /// element), for the kinds that carry a displacement gauge (spec physics.md §5).
     pub fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
-        let (upper, lower) = self.attachments()?;
-        Some(Relative::new(upper, lower, states).d)
+        match self {
+            Element::ShearPad(e) => Some(e.relative(states).d),
+            _ => {
+                let (upper, lower, rest) = self.attachments()?;
+                Some(Relative::new(upper, lower, rest, states).d)
+            }
+        }
     }
 
     /// The displacement gauges across this element: channel name and axis (0 x, 1 y, 2 z) of
@@ -91,7 +103,7 @@ impl Element {
     /// (`sidebearer_<bolster>_<l|r>_z`), centre plates vertical (`centreplate_<bolster>_z`).
     /// Vertical readings are positive in compression.
     pub fn gauges(&self, bodies: &[super::body::Body]) -> Vec<(String, usize)> {
-        let Some((upper, lower)) = self.attachments() else {
+        let Some((upper, lower, _)) = self.attachments() else {
             return Vec::new();
         };
         let (u, l) = (&bodies[upper.body].name, &bodies[lower.body].name);
@@ -121,12 +133,12 @@ impl Element {
         }
     }
 
-    fn attachments(&self) -> Option<(&Attachment, &Attachment)> {
+    fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
         match self {
-            Element::ShearPad(e) => Some((&e.upper, &e.lower)),
-            Element::SpringNest(e) => Some((&e.upper, &e.lower)),
-            Element::CentrePlate(e) => Some((&e.upper, &e.lower)),
-            Element::SideBearer(e) => Some((&e.upper, &e.lower)),
+            Element::ShearPad(e) => Some((&e.upper, &e.lower, &e.rest)),
+            Element::SpringNest(e) => Some((&e.upper, &e.lower, &e.rest)),
+            Element::CentrePlate(e) => Some((&e.upper, &e.lower, &e.rest)),
+            Element::SideBearer(e) => Some((&e.upper, &e.lower, &e.rest)),
             _ => None,
         }
     }
@@ -150,7 +162,8 @@ impl Element {
 pub(crate) struct Relative {
     /// Upper body axes.
     pub axes: Matrix3<f64>,
-    /// Displacement of the lower attachment relative to the upper, upper axes.
+    /// Displacement of the lower attachment relative to the upper, upper axes, less the static
+    /// offset between the two (zero at the static position).
     pub d: Vector3<f64>,
     /// Velocity of the lower attachment relative to the upper, upper axes.
     pub v: Vector3<f64>,
@@ -162,12 +175,17 @@ pub(crate) struct Relative {
 
 impl Relative {
     #[inline]
-    pub fn new(upper: &Attachment, lower: &Attachment, states: &[BodyState]) -> Self {
+    pub fn new(
+        upper: &Attachment,
+        lower: &Attachment,
+        rest: &Vector3<f64>,
+        states: &[BodyState],
+    ) -> Self {
         let (su, sl) = (&states[upper.body], &states[lower.body]);
         let axes = su.matrix();
         let p_upper = su.point(&upper.local);
         let p_lower = sl.point(&lower.local);
-        let d = axes.transpose() * (p_lower - p_upper);
+        let d = axes.transpose() * (p_lower - p_upper) - rest;
         let v =
             axes.transpose() * (sl.point_velocity(&lower.local) - su.point_velocity(&upper.local));
         Relative {
@@ -179,7 +197,9 @@ impl Relative {
         }
     }
 
-    /// Applies `f_upper_local` (upper axes) to the upper body and its opposite to the lower.
+    /// Applies `f_upper_local` (upper axes) to the upper body at its point and its opposite to
+    /// the lower body at its point; the couple of the offset between the points goes to the
+    /// upper body (module docs), so the element's moments balance.
     #[inline]
     pub fn apply(
         &self,
@@ -191,17 +211,7 @@ impl Relative {
     ) {
         let f = self.axes * f_upper_local;
         wrenches[upper.body].add_at(f, self.p_upper, states[upper.body].position);
+        wrenches[upper.body].torque += (self.p_lower - self.p_upper).cross(&f);
         wrenches[lower.body].add_at(-f, self.p_lower, states[lower.body].position);
-    }
-}
-
-/// Smooth friction direction factor `tanh(|v|/v_ref)·v/|v|` (a regularised sign, spec §2).
-#[inline]
-pub(crate) fn friction_dir(v: Vector3<f64>, v_ref: f64) -> Vector3<f64> {
-    let n = v.norm();
-    if n < 1e-12 {
-        Vector3::zeros()
-    } else {
-        v * ((n / v_ref).tanh() / n)
     }
 }

@@ -1,10 +1,25 @@
-//! Axle-box rubber shear pad: linear spring–damper in three directions.
+//! Axle-box rubber shear pad: linear spring–damper in three directions, and the pad's
+//! resistance to the side frame rolling on it.
+//!
+//! A pad of lateral width `w` is a bed of vertical springs under the pedestal roof: rolling
+//! the side frame by θ on it takes `M = k_z·w²/12·θ` (the bed's second moment, k_z spread
+//! evenly over the width), damped alike (`c_z·w²/12`), until the compressed edge carries the
+//! whole load and the roof tips on it: |M| ≤ N·w/2 with N the pad's current vertical force.
+//! With `w = 0` the pad is a point spring and the side frame rolls freely about the line of
+//! its two pads.
+//!
+//! The pad sits between the pedestal roof of the side frame (`upper_at`) and the crown of the
+//! bearing adapter (`lower_at`), well above the axle's centre line. The adapter rides on the
+//! bearing: it rolls and yaws with the axle but does not spin with it, and the pedestal jaws
+//! hold its pitch to the side frame's. So the crown is found in the adapter's axes (the axle's
+//! direction, and the side frame's vertical square to it), and the pad's moment about the
+//! axle's axis goes to the side frame through the jaws, never spinning the wheelset.
 
 use super::Relative;
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use serde::Deserialize;
 
 /// Shear pad between a side frame (upper) and a wheelset's axle box (lower).
@@ -12,23 +27,96 @@ use serde::Deserialize;
 pub struct ShearPad {
     /// Side frame.
     pub upper: Attachment,
-    /// Axle box: a point on the axle's axis, so the wheelset's spin does not move it.
+    /// Adapter crown on the wheelset: its point relative to the axle's centre, read in the
+    /// adapter's axes (which do not spin), m.
     pub lower: Attachment,
+    /// Static offset of the lower point from the upper (`lower_at − upper_at`), m.
+    pub rest: Vector3<f64>,
     /// Stiffness (x, y, z), N/m.
     pub stiffness: Vector3<f64>,
     /// Damping (x, y, z), N·s/m.
     pub damping: Vector3<f64>,
     /// Static vertical load carried, N.
     pub preload: f64,
+    /// Lateral width of the pad under the pedestal roof, m (0: no roll resistance).
+    pub width: f64,
 }
 
 impl ShearPad {
+    /// The adapter's axes in the world: x ahead, y along the axle, z the side frame's vertical
+    /// made square to the axle.
+    fn adapter_axes(&self, states: &[BodyState]) -> Matrix3<f64> {
+        let (su, sl) = (&states[self.upper.body], &states[self.lower.body]);
+        let a = sl.rotation * Vector3::y();
+        let up = su.rotation * Vector3::z();
+        let z = (up - a * up.dot(&a)).normalize();
+        Matrix3::from_columns(&[a.cross(&z), a, z])
+    }
+
+    /// Relative motion across the pad: the adapter crown against the pedestal roof.
+    pub(crate) fn relative(&self, states: &[BodyState]) -> Relative {
+        let (su, sl) = (&states[self.upper.body], &states[self.lower.body]);
+        let axes = su.matrix();
+        let p_upper = su.point(&self.upper.local);
+        let ad = self.adapter_axes(states);
+        let a = ad.column(1).into_owned();
+        let crown = ad * self.lower.local;
+        let p_lower = sl.position + crown;
+        // The adapter turns with the axle but for its spin, which it takes from the side frame.
+        let w_adapter =
+            sl.angular_velocity - a * sl.angular_velocity.dot(&a) + a * su.angular_velocity.dot(&a);
+        let v_lower = sl.velocity + w_adapter.cross(&crown);
+        Relative {
+            axes,
+            d: axes.transpose() * (p_lower - p_upper) - self.rest,
+            v: axes.transpose() * (v_lower - su.point_velocity(&self.upper.local)),
+            p_upper,
+            p_lower,
+        }
+    }
+
     pub(crate) fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
-        let r = Relative::new(&self.upper, &self.lower, states);
+        let r = self.relative(states);
         let f = self.stiffness.component_mul(&r.d)
             + self.damping.component_mul(&r.v)
             + Vector3::new(0.0, 0.0, self.preload);
         r.apply(f, &self.upper, &self.lower, states, wrenches);
+        // The moment about the axle's axis of the force at the crown goes through the adapter's
+        // jaws to the side frame: the bearing carries none.
+        let sl = &states[self.lower.body];
+        let a = sl.rotation * Vector3::y();
+        let t = (r.p_lower - sl.position).cross(&(-(r.axes * f)));
+        let axial = a * t.dot(&a);
+        wrenches[self.lower.body].torque -= axial;
+        wrenches[self.upper.body].torque += axial;
+        if self.width > 0.0 {
+            let (su, sl) = (&states[self.upper.body], &states[self.lower.body]);
+            // The axle's direction in the side frame's axes gives their relative roll θ,
+            // independent of the wheelset's spin about that axis.
+            let axle = sl.matrix().column(1).into_owned();
+            let a = r.axes.transpose() * axle;
+            let theta = (-a.z).atan2(a.y);
+            let w_lower = sl.angular_velocity - axle * sl.angular_velocity.dot(&axle);
+            let x_upper = r.axes.column(0).into_owned();
+            let theta_dot = (su.angular_velocity - w_lower).dot(&x_upper);
+            let m = self.rocking_moment(theta, theta_dot, f.z);
+            wrenches[self.upper.body].torque -= x_upper * m;
+            wrenches[self.lower.body].torque += x_upper * m;
+        }
+    }
+
+    /// Rolling moment the pad's width resists with, per radian of relative roll, N·m/rad.
+    pub fn rocking_stiffness(&self) -> f64 {
+        self.stiffness.z * self.width * self.width / 12.0
+    }
+
+    /// Moment (N·m) resisting the side frame's roll `theta` (rad) relative to the axle at the
+    /// rate `theta_dot` (rad/s) with the pad carrying `normal` (N): the spring bed's
+    /// `(k_z·θ + c_z·θ̇)·w²/12`, no more than the load tipping on an edge, `N·w/2`.
+    pub fn rocking_moment(&self, theta: f64, theta_dot: f64, normal: f64) -> f64 {
+        let tip = 0.5 * self.width * normal.max(0.0);
+        (self.width * self.width / 12.0 * (self.stiffness.z * theta + self.damping.z * theta_dot))
+            .clamp(-tip, tip)
     }
 }
 
@@ -38,23 +126,35 @@ impl ShearPad {
 pub(crate) struct ShearPadFile {
     upper: String,
     lower: String,
-    at: [f64; 3],
+    /// Refused: one point for both bodies (see `Binder::pair`).
+    at: Option<[f64; 3]>,
+    /// Where the element meets the upper body, vehicle frame, m.
+    upper_at: Option<[f64; 3]>,
+    /// Where the element meets the lower body, vehicle frame, m.
+    lower_at: Option<[f64; 3]>,
     stiffness: [f64; 3],
     #[serde(default)]
     damping: [f64; 3],
+    /// Lateral width of the pad, m (0 or absent: a point spring).
+    #[serde(default)]
+    width_m: f64,
 }
 
 impl ShearPad {
     pub(crate) fn bind(f: &str, e: &ShearPadFile, b: &Binder) -> Result<Self> {
         b.non_negative(format!("{f}.stiffness"), &e.stiffness)?;
         b.non_negative(format!("{f}.damping"), &e.damping)?;
-        let (upper, lower) = b.pair(f, &e.upper, &e.lower, e.at)?;
+        b.non_negative(format!("{f}.width_m"), &[e.width_m])?;
+        let (upper, lower, rest) =
+            b.pair(f, (&e.upper, &e.lower), e.at, (e.upper_at, e.lower_at))?;
         Ok(ShearPad {
             upper,
             lower,
+            rest,
             stiffness: Vector3::from(e.stiffness),
             damping: Vector3::from(e.damping),
             preload: 0.0,
+            width: e.width_m,
         })
     }
 }

@@ -1,13 +1,15 @@
-//! Constant-contact side bearer: preloaded vertical spring that only pushes, with sliding
-//! friction in the horizontal plane (smoothed by tanh), and a solid stop: after `travel` of
+//! Constant-contact side bearer: preloaded vertical spring that only pushes, with friction in
+//! the horizontal plane that sticks (the cap's elastomer in shear, `stick_stiffness`, in series
+//! with a Coulomb slider at `μ·N`: the elasto-plastic element of the wedges), and a solid stop:
+//! after `travel` of
 //! compression beyond the static position the cage bottoms out and the much stiffer stop
 //! (bolster and carbody bolster in series) carries the rest.
 
-use super::{Relative, friction_dir};
+use super::{Memory, Relative, slider};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
-use nalgebra::Vector3;
+use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
 
 /// Side bearer between the carbody (upper) and a bolster (lower).
@@ -17,14 +19,18 @@ pub struct SideBearer {
     pub upper: Attachment,
     /// Bolster bearer.
     pub lower: Attachment,
+    /// Static offset of the lower point from the upper (`lower_at − upper_at`), m.
+    pub rest: Vector3<f64>,
     /// Vertical stiffness, N/m.
     pub stiffness: f64,
     /// Preload at the static position, N.
     pub preload: f64,
     /// Friction coefficient.
     pub friction: f64,
-    /// Regularisation velocity, m/s.
-    pub regularisation_velocity: f64,
+    /// Horizontal stiffness of the stuck bearer (x and y), N/m.
+    pub stick_stiffness: f64,
+    /// Vertical damping of the elastomer, N·s/m.
+    pub damping: f64,
     /// Compression from the static position at which the bearer goes solid, m (∞: no stop).
     pub travel: f64,
     /// Stiffness of the solid stop, N/m.
@@ -40,12 +46,21 @@ impl SideBearer {
             .max(0.0)
     }
 
-    pub(crate) fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
-        let r = Relative::new(&self.upper, &self.lower, states);
-        let normal = self.vertical_force(r.d.z);
-        let slip = Vector3::new(r.v.x, r.v.y, 0.0);
-        let mut f = friction_dir(slip, self.regularisation_velocity) * (self.friction * normal);
-        f.z = normal;
+    pub(crate) fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+        let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
+        let normal = (self.vertical_force(r.d.z) + self.damping * r.v.z).max(0.0);
+        let mut s = Vector2::new(memory[0], memory[1]);
+        // The lower body moving by d drags the upper along: the force on the upper is +F.
+        let h = slider(
+            &Vector2::new(r.d.x, r.d.y),
+            &Vector2::new(r.v.x, r.v.y),
+            &mut s,
+            self.stick_stiffness,
+            0.0,
+            self.friction * normal,
+        );
+        (memory[0], memory[1]) = (s.x, s.y);
+        let f = Vector3::new(h.x, h.y, normal);
         r.apply(f, &self.upper, &self.lower, states, wrenches);
     }
 }
@@ -56,11 +71,20 @@ impl SideBearer {
 pub(crate) struct SideBearerFile {
     upper: String,
     lower: String,
-    at: [f64; 3],
+    /// Refused: one point for both bodies (see `Binder::pair`).
+    at: Option<[f64; 3]>,
+    /// Where the element meets the upper body, vehicle frame, m.
+    upper_at: Option<[f64; 3]>,
+    /// Where the element meets the lower body, vehicle frame, m.
+    lower_at: Option<[f64; 3]>,
     stiffness: f64,
     preload_n: f64,
     friction: f64,
-    regularisation_velocity: f64,
+    /// Horizontal stick stiffness, N/m.
+    stick_stiffness: f64,
+    /// Vertical damping, N·s/m.
+    #[serde(default)]
+    damping: f64,
     /// Compression travel from the static position to solid, m (absent: no stop).
     travel_m: Option<f64>,
     /// Stop stiffness, N/m.
@@ -78,23 +102,24 @@ impl SideBearer {
             format!("{f}.stiffness"),
             &[e.stiffness, e.preload_n, e.friction],
         )?;
-        b.positive(
-            format!("{f}.regularisation_velocity"),
-            e.regularisation_velocity,
-        )?;
+        b.positive(format!("{f}.stick_stiffness"), e.stick_stiffness)?;
+        b.non_negative(format!("{f}.damping"), &[e.damping])?;
         b.non_negative(format!("{f}.stop_stiffness"), &[e.stop_stiffness])?;
         let travel = match e.travel_m {
             Some(t) => b.positive(format!("{f}.travel_m"), t)?,
             None => f64::INFINITY,
         };
-        let (upper, lower) = b.pair(f, &e.upper, &e.lower, e.at)?;
+        let (upper, lower, rest) =
+            b.pair(f, (&e.upper, &e.lower), e.at, (e.upper_at, e.lower_at))?;
         Ok(SideBearer {
             upper,
             lower,
+            rest,
             stiffness: e.stiffness,
             preload: e.preload_n,
             friction: e.friction,
-            regularisation_velocity: e.regularisation_velocity,
+            stick_stiffness: e.stick_stiffness,
+            damping: e.damping,
             travel,
             stop_stiffness: e.stop_stiffness,
         })

@@ -1,8 +1,12 @@
 //! Variable-friction wedge damper of a three-piece bogie as a friction element that sticks:
 //! a Coulomb slider in series with a stick spring (elasto-plastic friction, e.g. Dahl's
 //! bristle idea without its rate law), so a stuck wedge is a stiff spring, not a big damper,
-//! and needs no tiny step. The friction limit follows the load of the spring nest beside it
-//! (`friction_ratio` ≈ 0.08–0.1 × nest force, spec physics.md §2).
+//! and needs no tiny step. K6 variable friction: each wedge rides on its own control spring
+//! (part of the nest, taller than the outer coils), whose force P presses it through its sloped
+//! face against the column with `N = P / tan α` (α the slope's angle from the vertical column
+//! face; friction on the slope neglected, so up and down strokes damp alike); the column face
+//! slips at `μ·N` (spec physics.md §2). The control springs' extra height keeps them loaded
+//! when the empty wagon barely compresses the load springs: relatively more friction empty.
 //!
 //! - Column face (lateral y, vertical z of the bolster): force `k_s·(d − s) + c_s·v`, with the
 //!   slider `s` moving only as far as keeps `|F| ≤ μ·N` (slip in the direction of the force).
@@ -24,8 +28,12 @@ pub struct WedgeDamper {
     pub upper: Attachment,
     /// Side frame column.
     pub lower: Attachment,
-    /// Friction force over nest force.
-    pub friction_ratio: f64,
+    /// Static offset of the lower point from the upper (`lower_at − upper_at`), m.
+    pub rest: Vector3<f64>,
+    /// Friction coefficient of the column face.
+    pub friction: f64,
+    /// Angle of the wedge's sloped face from the vertical column face, rad.
+    pub angle: f64,
     /// Stick stiffness on the column face (y and z), N/m.
     pub stick_stiffness: f64,
     /// Damping in parallel with the stick spring, N·s/m.
@@ -63,9 +71,30 @@ pub fn slider<const N: usize>(
 }
 
 impl WedgeDamper {
+    /// Force with which the wedges press the column face, `N = P / tan α`, for the control
+    /// springs' force `p` (N).
+    #[inline]
+    pub fn column_normal(&self, p: f64) -> f64 {
+        p / self.angle.tan()
+    }
+
+    /// Friction limit of the column face and the nest's vertical force, for the nest at
+    /// compression `c` (m): `(μ·N, F_nest)`, N.
+    #[inline]
+    pub fn limits(&self, c: f64) -> (f64, f64) {
+        let law = &self.nest.law;
+        (
+            self.friction * self.column_normal(law.control_force(c)),
+            law.force(c),
+        )
+    }
+
     pub(crate) fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
-        let r = Relative::new(&self.upper, &self.lower, states);
-        let normal = self.nest.vertical_force(&r);
+        let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
+        // The nest's own compression (its points are not the wedge's) sets the control springs.
+        let n = &self.nest;
+        let c = n.static_compression + Relative::new(&n.upper, &n.lower, &n.rest, states).d.z;
+        let (limit, nest_force) = self.limits(c);
         let mut s = Vector2::new(memory[0], memory[1]);
         let face = slider(
             &Vector2::new(r.d.y, r.d.z),
@@ -73,7 +102,7 @@ impl WedgeDamper {
             &mut s,
             self.stick_stiffness,
             self.stick_damping,
-            self.friction_ratio * normal,
+            limit,
         );
         memory[0] = s.x;
         memory[1] = s.y;
@@ -94,7 +123,7 @@ impl WedgeDamper {
                 &mut sp,
                 self.warp_stiffness,
                 0.0,
-                self.warp_ratio * normal,
+                self.warp_ratio * nest_force,
             )
             .x;
             memory[2] = sp.x;
@@ -110,8 +139,14 @@ impl WedgeDamper {
 pub(crate) struct WedgeDamperFile {
     pub upper: String,
     pub lower: String,
-    at: [f64; 3],
-    friction_ratio: f64,
+    /// Refused: one point for both bodies (see `Binder::pair`).
+    at: Option<[f64; 3]>,
+    /// Where the element meets the upper body, vehicle frame, m.
+    upper_at: Option<[f64; 3]>,
+    /// Where the element meets the lower body, vehicle frame, m.
+    lower_at: Option<[f64; 3]>,
+    friction: f64,
+    wedge_angle_deg: f64,
     stick_stiffness: f64,
     #[serde(default)]
     stick_damping: f64,
@@ -131,7 +166,22 @@ impl WedgeDamper {
         nest: super::SpringNest,
         b: &Binder,
     ) -> Result<Self> {
-        b.non_negative(format!("{f}.friction_ratio"), &[e.friction_ratio])?;
+        b.non_negative(format!("{f}.friction"), &[e.friction])?;
+        if !(e.wedge_angle_deg > 5.0 && e.wedge_angle_deg < 85.0) {
+            return Err(b.err(
+                format!("{f}.wedge_angle_deg"),
+                format!(
+                    "must lie in (5, 85)° from the vertical column face, got {}",
+                    e.wedge_angle_deg
+                ),
+            ));
+        }
+        if nest.law.control <= 0.0 {
+            return Err(b.err(
+                format!("{f}.upper"),
+                "the spring_nest beside this wedge has no control_stiffness: a K6 wedge is pressed by its own control springs (spring_nest.control_stiffness, control_extra_height_m)",
+            ));
+        }
         b.positive(format!("{f}.stick_stiffness"), e.stick_stiffness)?;
         b.non_negative(
             format!("{f}.stick_damping"),
@@ -141,11 +191,14 @@ impl WedgeDamper {
             format!("{f}.warp_stiffness"),
             &[e.warp_stiffness, e.warp_ratio_m],
         )?;
-        let (upper, lower) = b.pair(f, &e.upper, &e.lower, e.at)?;
+        let (upper, lower, rest) =
+            b.pair(f, (&e.upper, &e.lower), e.at, (e.upper_at, e.lower_at))?;
         Ok(WedgeDamper {
             upper,
             lower,
-            friction_ratio: e.friction_ratio,
+            rest,
+            friction: e.friction,
+            angle: e.wedge_angle_deg.to_radians(),
             stick_stiffness: e.stick_stiffness,
             stick_damping: e.stick_damping,
             longitudinal_stiffness: e.longitudinal_stiffness,
