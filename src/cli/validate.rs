@@ -271,45 +271,91 @@ fn fidelity(
         "tracks/tangent.toml",
     ))?)?;
     let e = railforce::vehicle::Vehicle::load(&super::builtin::resolve(empty)?)?;
-    let (from, to, decel) = (COAST_FROM_KMH / 3.6, 50.0 / 3.6, 2.0);
-    // Hunting depends first on the wheel–rail pair's equivalent conicity: say which one ran.
-    match v.contact.table().equivalent_conicity(0.003) {
-        Some(l) => println!(
-            "  wheel–rail pair of {}: equivalent conicity {l:.4} at 3 mm amplitude (EN 15302)",
-            v.name
-        ),
-        None => println!("  equivalent conicity at 3 mm: not defined for this profile pair"),
-    }
-    let mut found = Vec::new();
-    for w in [v, &e] {
-        let c = fd::critical_speed(w, &smooth, from, to, decel)?;
-        match c.critical {
-            Some(s) => println!(
-                "  kink-and-coast from {:.0} km/h at {decel} m/s² on smooth tangent, {}: hunting dies out at {:.0} km/h",
-                from * 3.6,
+    // The side frames hang on their pads (issue 33): their roll relative to the track, class 5.
+    for (track, kmh) in [
+        ("tracks/tangent.toml", 80.0),
+        ("tracks/curve_r400.toml", 60.0),
+    ] {
+        let t =
+            railforce::track::Track::load(&super::builtin::resolve(std::path::Path::new(track))?)?;
+        for w in [v, &e] {
+            let rec = fd::run(w, &t, kmh / 3.6, 30.0, cfg.dt)?;
+            let r = fd::sideframe_roll(&rec)?;
+            println!(
+                "  side-frame roll, {}, class 5, {kmh:.0} km/h, 30 s, {}: std {:.1} mrad, peak {:.1} mrad (≤ 8 / ≤ 25 mrad)  {}",
+                t.spec().name,
                 w.name,
-                s * 3.6
+                r.std * 1e3,
+                r.peak * 1e3,
+                verdict(r.std <= 8e-3 && r.peak <= 25e-3)
+            );
+        }
+    }
+    let (from, to) = (COAST_FROM_KMH / 3.6, 50.0 / 3.6);
+    // Hunting depends first on the wheel–rail pair's equivalent conicity: say which one ran,
+    // and repeat with S1002 set at wider flange backs (its conicity rises steeply with them).
+    for delta in [0.0, 0.003, 0.007] {
+        let (vl, ve) = (
+            v.with_flange_back_changed(delta),
+            e.with_flange_back_changed(delta),
+        );
+        let g = &vl.contact.geometry;
+        match vl.contact.table().equivalent_conicity(0.003) {
+            Some(l) => println!(
+                "  flange back {:.0} mm: equivalent conicity {l:.4} at 3 mm amplitude (EN 15302){}",
+                g.flange_back * 1e3,
+                if delta == 0.0 {
+                    " — the vehicle files' pair"
+                } else {
+                    " (reported)"
+                }
             ),
             None => println!(
-                "  kink-and-coast from {:.0} km/h at {decel} m/s² on smooth tangent, {}: no hunting at {:.0} km/h",
-                from * 3.6,
-                w.name,
-                from * 3.6
+                "  flange back {:.0} mm: equivalent conicity at 3 mm not defined",
+                g.flange_back * 1e3
             ),
         }
-        if std::env::var_os("RAILFORCE_VERBOSE").is_some() {
-            for (v, a) in &c.blocks {
-                eprintln!("    {:.0} km/h: {:.2} mm", v * 3.6, a * 1e3);
+        let mut speeds = [[f64::INFINITY; 2]; 2];
+        for (m, method) in ["kink-and-coast", "run-down"].iter().enumerate() {
+            for (k, w) in [&vl, &ve].into_iter().enumerate() {
+                let c = if m == 0 {
+                    fd::critical_speed(w, &smooth, from, to, 2.0)?
+                } else {
+                    fd::run_down(w, &smooth, from, to, 1.5)?
+                };
+                speeds[m][k] = c.critical.unwrap_or(f64::INFINITY);
+                let how = if m == 0 {
+                    "6 mm kink, 2 m/s²".to_string()
+                } else {
+                    format!("kicked {} m/s, 1.5 m/s²", fd::RUN_DOWN_KICK)
+                };
+                match c.critical {
+                    Some(s) => println!(
+                        "    {method} from {:.0} km/h ({how}), {}: hunting dies out at {:.0} km/h",
+                        from * 3.6,
+                        w.name,
+                        s * 3.6
+                    ),
+                    None => println!(
+                        "    {method} from {:.0} km/h ({how}), {}: no hunting",
+                        from * 3.6,
+                        w.name
+                    ),
+                }
+                if std::env::var_os("RAILFORCE_VERBOSE").is_some() {
+                    for (v, a) in &c.blocks {
+                        eprintln!("      {:.0} km/h: {:.2} mm", v * 3.6, a * 1e3);
+                    }
+                }
             }
         }
-        found.push(c.critical.unwrap_or(f64::INFINITY));
+        let first = |s: [f64; 2]| s[1] < s[0];
+        println!(
+            "    the empty wagon hunts first (critical speed below the loaded one's): kink-and-coast {}, run-down {} (reported)",
+            if first(speeds[0]) { "yes" } else { "no" },
+            if first(speeds[1]) { "yes" } else { "no" }
+        );
     }
-    // Reported, not judged: with the K6's cross-bracing, sticking constant-contact side
-    // bearers and side frames upright on their pads, the empty wagon does not hunt (README).
-    println!(
-        "  the empty wagon hunts first (critical speed below the loaded one's): {} (reported)",
-        if found[1] < found[0] { "yes" } else { "no" }
-    );
     // Reported, not judged: a limit cycle that a large kink starts at service speed.
     let (secs, tail) = (35.0, 5.0);
     for speed in [90.0, 120.0] {

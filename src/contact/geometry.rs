@@ -51,6 +51,8 @@ pub struct WheelsetGeometry {
     pub tape_circle_half: f64,
     /// Half the track gauge, m.
     pub half_gauge: f64,
+    /// Flange back-to-back distance, m.
+    pub flange_back: f64,
 }
 
 /// Contact between one wheel and its rail.
@@ -181,6 +183,7 @@ impl WheelsetGeometry {
             nominal_radius,
             tape_circle_half,
             half_gauge,
+            flange_back,
         })
     }
 

@@ -1,6 +1,6 @@
-//! Checks of the simulator's fidelity beyond the closed forms of [`super::checks`] (issue 17):
-//! the critical speed by kink-and-coast and the motion left long after a kink at constant
-//! speed, the high-frequency content of the wheel forces in a
+//! Checks of the simulator's fidelity beyond the closed forms of [`super::checks`] (issues 17,
+//! 33): the critical speed by kink-and-coast and by run-down, the motion left long after a kink
+//! at constant speed, the side frames' roll, the high-frequency content of the wheel forces in a
 //! tight curve, convergence in the step, the anti-alias filter at the output's Nyquist
 //! frequency and the smoothness of the recorded track position.
 
@@ -62,7 +62,39 @@ pub fn critical_speed(
     to: f64,
     decel: f64,
 ) -> Result<CriticalSpeed> {
-    let hold = 5.0;
+    coast(vehicle, track, (from, to, decel), 5.0, None)
+}
+
+/// Lateral velocity given to every wheelset by [`run_down`]'s kick, m/s (alternating in
+/// sign from wheelset to wheelset, so the bogies yaw): enough to throw the leading wheelset
+/// onto its flange at the top speed.
+pub const RUN_DOWN_KICK: f64 = 0.25;
+
+/// The run-down of Iwnicki, Stichel, Orlova & Hecht (2015, "Dynamics of railway freight
+/// vehicles", Vehicle System Dynamics 53): the kink of [`critical_speed`], then a large kick
+/// at the top speed `from` ([`RUN_DOWN_KICK`] to every wheelset, flange to flange), 8 s held
+/// there so a limit cycle can form, then a slow run down at `decel`. It starts on the limit
+/// cycle where one exists, so it finds the lowest speed at which that cycle survives (the
+/// nonlinear critical speed), which a small kink at a lower speed can overstate.
+pub fn run_down(
+    vehicle: &Vehicle,
+    track: &Track,
+    from: f64,
+    to: f64,
+    decel: f64,
+) -> Result<CriticalSpeed> {
+    coast(vehicle, track, (from, to, decel), 8.0, Some(RUN_DOWN_KICK))
+}
+
+/// The coast of both tests: the kinked run held `hold` s at `from` (kicked after 0.5 s when
+/// `kick` is given, m/s), then slowing at `decel` to `to`.
+fn coast(
+    vehicle: &Vehicle,
+    track: &Track,
+    (from, to, decel): (f64, f64, f64),
+    hold: f64,
+    kick: Option<f64>,
+) -> Result<CriticalSpeed> {
     let duration = hold + (from - to) / decel + 2.0;
     let mut sim = kinked(vehicle, track, from, duration)?;
     let lead = 0;
@@ -70,8 +102,20 @@ pub fn critical_speed(
     let mut blocks = Vec::new();
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     let mut n = 0;
+    let mut kick = kick;
     while sim.time() < duration {
         let t = sim.time();
+        if let Some(dv) = kick.filter(|_| t >= 0.5) {
+            for (k, &w) in vehicle.contact.wheelsets.iter().enumerate() {
+                let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+                sim.kick(
+                    w,
+                    nalgebra::Vector3::new(0.0, sign * dv, 0.0),
+                    nalgebra::Vector3::zeros(),
+                );
+            }
+            kick = None;
+        }
         let v = if t < hold {
             from
         } else {
@@ -97,6 +141,44 @@ pub fn critical_speed(
         .last()
         .map(|b| b.0);
     Ok(CriticalSpeed { critical, blocks })
+}
+
+/// Roll of the side frames relative to the track frame (the `sideframe*_roll` channels):
+/// standard deviation and peak over all of them, rad.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SideFrameRoll {
+    /// Largest standard deviation of one side frame's roll, rad.
+    pub std: f64,
+    /// Largest |roll| of any side frame, rad.
+    pub peak: f64,
+}
+
+/// Side-frame roll over a recording (every `sideframe*_roll` channel; a real three-piece side
+/// frame hangs on its pads and rolls well under a degree).
+pub fn sideframe_roll(rec: &Recording) -> Result<SideFrameRoll> {
+    let mut out = SideFrameRoll {
+        std: 0.0,
+        peak: 0.0,
+    };
+    let names: Vec<&String> = rec
+        .names
+        .iter()
+        .filter(|n| n.starts_with("sideframe") && n.ends_with("_roll"))
+        .collect();
+    if names.is_empty() {
+        return Err(Error::Domain(
+            "no sideframe*_roll channel in the recording".into(),
+        ));
+    }
+    for name in names {
+        let x = column(rec, name)?;
+        let n = x.len().max(1) as f64;
+        let mean = x.iter().sum::<f64>() / n;
+        let sd = (x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+        out.std = out.std.max(sd);
+        out.peak = x.iter().fold(out.peak, |p, v| p.max(v.abs()));
+    }
+    Ok(out)
 }
 
 /// Stability at one constant speed: what is left of the kink after a long run.

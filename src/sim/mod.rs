@@ -309,6 +309,15 @@ impl<'a> Simulation<'a> {
         self.cfg.speed = speed;
     }
 
+    /// Adds `dv` (m/s) to the velocity and `dw` (rad/s) to the angular velocity of `body`,
+    /// both in its track frame's axes (x along, y left, z up): a kick for stability tests (the
+    /// run-down of [`fidelity::run_down`], a side frame rolled and let go).
+    pub fn kick(&mut self, body: usize, dv: Vector3<f64>, dw: Vector3<f64>) {
+        let axes = self.frames[body].axes;
+        self.states[body].velocity += axes * dv;
+        self.states[body].angular_velocity += axes * dw;
+    }
+
     /// Settings.
     pub fn config(&self) -> &SimConfig {
         &self.cfg

@@ -179,6 +179,18 @@ impl Vehicle {
         self.mass() * crate::GRAVITY / (2 * self.contact.wheelsets.len()) as f64 * 1e-3
     }
 
+    /// The same vehicle with its wheelsets' flange back-to-back distance changed by `delta`
+    /// (m; the tape circles move out by half of it each). S1002's equivalent conicity turns
+    /// with it (0.018 at the Chinese 1 353 mm, 0.18 at its design 1 360 mm), and so does the
+    /// hunting (README, "Stability").
+    pub fn with_flange_back_changed(&self, delta: f64) -> Vehicle {
+        let mut v = self.clone();
+        v.contact.geometry.tape_circle_half += 0.5 * delta;
+        v.contact.geometry.flange_back += delta;
+        v.contact.table = std::sync::OnceLock::new();
+        v
+    }
+
     /// Index of a body by name.
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
