@@ -364,3 +364,68 @@ fn model_and_data_set_files_parse_or_say_why() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A run cut short, or with a row of other length, is refused in every run format, naming the
+/// file and the row or column: `view` and `assess` index any column by row and panicked on a
+/// CSV truncated inside its last row (issue 34).
+#[test]
+fn run_files_cut_short_are_refused_in_every_format() {
+    use railforce::dataset::{npz, parquet_file};
+    use railforce::features::samples::read_table;
+    let dir = std::env::temp_dir().join(format!("railforce-cut-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let n = 50;
+    let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.005).collect();
+    let a: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).sin() * 1e4).collect();
+    let b = vec![2.5; n];
+    // CSV: the header and n rows; cut inside the last row, and a row with a field too many.
+    let mut csv = String::from("time_s,a,b\n");
+    for i in 0..n {
+        csv += &format!("{},{},{}\n", t[i], a[i], b[i]);
+    }
+    let cut = dir.join("cut.csv");
+    let last = csv.trim_end().rfind('\n').unwrap();
+    std::fs::write(&cut, &csv[..last + 6]).unwrap();
+    let e = read_table(&cut).unwrap_err().to_string();
+    assert!(
+        e.contains("cut.csv") && e.contains(&format!("row {n}")) && e.contains("cut short"),
+        "{e}"
+    );
+    let long = dir.join("long.csv");
+    std::fs::write(&long, csv.replacen("\n0.05,", "\n0.05,7,", 1)).unwrap();
+    let e = read_table(&long).unwrap_err().to_string();
+    assert!(
+        e.contains("long.csv") && e.contains("row 11 has 4 field(s)"),
+        "{e}"
+    );
+    // NPZ and Parquet: one array shorter than the others; and every cut of the bytes.
+    let short = &a[..n - 1];
+    let cols: [(&str, &[f64]); 3] = [("time_s", &t), ("a", short), ("b", &b)];
+    let mut bytes = Vec::new();
+    npz::write_npz(&mut bytes, &cols, false).unwrap();
+    let p = dir.join("short.npz");
+    std::fs::write(&p, &bytes).unwrap();
+    let e = read_table(&p).unwrap_err().to_string();
+    assert!(
+        e.contains("short.npz") && e.contains("column a has 49 rows"),
+        "{e}"
+    );
+    let pq = parquet_file::write_parquet(&[("time_s", &t), ("a", &a), ("b", &b)], false).unwrap();
+    for (name, whole) in [("cut.npz", bytes), ("cut.parquet", pq)] {
+        let p = dir.join(name);
+        for k in (1..whole.len()).step_by((whole.len() / 37).max(1)) {
+            std::fs::write(&p, &whole[..k]).unwrap();
+            match read_table(&p) {
+                Ok(table) => {
+                    let len = table[0].1.len();
+                    assert!(
+                        table.iter().all(|(_, c)| c.len() == len),
+                        "{name} cut at {k}"
+                    );
+                }
+                Err(e) => assert!(e.to_string().contains(name), "{name} cut at {k}: {e}"),
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

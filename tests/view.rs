@@ -184,6 +184,24 @@ fn a_run_without_the_channels_is_refused_by_name() {
         !out.status.success() && err.contains("not_there.csv: no such run file"),
         "{err}"
     );
+    // A run cut inside its last row is refused naming the row (it used to panic in `view` and
+    // was read short by `assess`).
+    let cut = tmp("cut_short.csv");
+    std::fs::write(&cut, "time_s,s_m,w1l_force_y\n0,0,1\n0.005,0.1,2\n0.01,0.").unwrap();
+    for cmd in ["view", "assess"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .args([cmd, cut.to_str().unwrap(), "--track", "tangent"])
+            .current_dir(root())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success()
+                && err.contains("cut_short.csv: row 3 has 2 field(s)")
+                && !err.contains("panicked"),
+            "{cmd}: {err}"
+        );
+    }
 }
 
 /// Chromium (or Chrome) on this machine, if any: `RAILFORCE_BROWSER` or the usual names.
