@@ -155,3 +155,27 @@ fn filter_and_wrapper_find_the_informative_channels() {
         .to_string();
     assert!(e.contains("unknown channel 'nonsense'"), "{e}");
 }
+
+/// The noise protocols and the shuffled split are decided in the library (issue 34): the
+/// names `train --noise` takes parse, others are refused, and the shuffled split keeps
+/// 70 / 15 % for training and validation.
+#[test]
+fn noise_protocols_parse_and_the_shuffled_split_has_its_fractions() {
+    use railforce::features::{NoiseProtocol, Split};
+    assert_eq!(NoiseProtocol::parse("clean"), Some(NoiseProtocol::Clean));
+    assert_eq!(
+        NoiseProtocol::parse("matched"),
+        Some(NoiseProtocol::Matched)
+    );
+    assert_eq!(
+        NoiseProtocol::parse("train-clean-test-noisy"),
+        Some(NoiseProtocol::TrainCleanTestNoisy)
+    );
+    assert_eq!(NoiseProtocol::parse("noisy"), None);
+    match Split::shuffled(7) {
+        Split::Shuffled { train, val, seed } => {
+            assert_eq!((train, val, seed), (0.70, 0.15, 7));
+        }
+        other => panic!("{other:?}"),
+    }
+}

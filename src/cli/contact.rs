@@ -212,12 +212,6 @@ fn y_over_q(f: &railforce::contact::WheelForces) -> f64 {
     }
 }
 
-/// Nadal's flange-climb limit for flange angle δ and friction μ.
-fn nadal(delta: f64, mu: f64) -> f64 {
-    let t = delta.tan();
-    (t - mu) / (1.0 + mu * t)
-}
-
 /// Parses `FROM:TO:STEP`.
 fn range(text: &str, what: &str) -> Result<Vec<f64>> {
     let parts: Vec<f64> = text
@@ -333,7 +327,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
         "{:<11} {:>8} {:>8} {:>9} {:>8} {:>8} {:>6} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8}",
         "", "um", "mm", "mm", "deg", "kN", "mm", "mm", "MPa", "", "", "1/m", "kN", "kN", "kN", "kN"
     );
-    let limit = nadal(setup.flange_angle, setup.model.friction);
+    let limit = railforce::contact::nadal_limit(setup.flange_angle, setup.model.friction);
     for wr in &st.wheels {
         let f = &wr.forces;
         let name = if wr.side == Side::Left {
@@ -428,7 +422,7 @@ fn sweep(setup: &Setup, args: &ContactArgs) -> Result<()> {
         Some(r) => range(r, "--sweep-yaw")?,
         None => vec![args.yaw_mrad],
     };
-    let limit = nadal(setup.flange_angle, setup.model.friction);
+    let limit = railforce::contact::nadal_limit(setup.flange_angle, setup.model.friction);
     let range_mm = railforce::vehicle::ContactSettings::TABLE_RANGE * 1e3;
     if let Some(y) = ys.iter().find(|y| y.abs() > range_mm) {
         bail!("--sweep-y reaches {y} mm, beyond the contact table's ±{range_mm:.0} mm");

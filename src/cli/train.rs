@@ -157,10 +157,9 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
     let noise = match args.noise.as_deref() {
         None if has_noisy => NoiseProtocol::Matched,
         None => NoiseProtocol::Clean,
-        Some("clean") => NoiseProtocol::Clean,
-        Some("matched") => NoiseProtocol::Matched,
-        Some("train-clean-test-noisy") => NoiseProtocol::TrainCleanTestNoisy,
-        Some(o) => bail!("--noise {o}: expected clean, matched or train-clean-test-noisy"),
+        Some(o) => NoiseProtocol::parse(o).ok_or_else(|| {
+            anyhow::anyhow!("--noise {o}: expected clean, matched or train-clean-test-noisy")
+        })?,
     };
     let split = split(args, ds)?;
     Ok(DataSpec {
@@ -191,11 +190,7 @@ pub fn split(args: &DataArgs, ds: &DataSet) -> Result<Split> {
     };
     let split = match kind {
         "blocks" => Split::default(),
-        "shuffled" => Split::Shuffled {
-            train: 0.70,
-            val: 0.15,
-            seed: 1,
-        },
+        "shuffled" => Split::shuffled(1),
         "conditions" => {
             if args.test_conditions.is_empty() {
                 bail!("--split conditions needs --test-conditions (and --val-conditions)");

@@ -18,3 +18,11 @@ pub use wheel_rail::{
     CREEP_SPEED_FLOOR, ContactFrame, ContactModel, PatchForce, WheelForces, WheelOnRail, evaluate,
     height_for_load,
 };
+
+/// Nadal's flange-climb limit `(tan δ − μ)/(1 + μ·tan δ)` of |Y|/Q for the flange angle δ
+/// (rad) and friction μ: the one formula the simulator's derailment check and `railforce
+/// contact` use.
+pub fn nadal_limit(flange_angle: f64, mu: f64) -> f64 {
+    let t = flange_angle.tan();
+    (t - mu) / (1.0 + mu * t)
+}

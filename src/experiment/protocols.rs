@@ -54,14 +54,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 test: held.clone(),
             },
         ),
-        (
-            "shuffled (leaky)",
-            Split::Shuffled {
-                train: 0.70,
-                val: 0.15,
-                seed: opts.train.seed,
-            },
-        ),
+        ("shuffled (leaky)", Split::shuffled(opts.train.seed)),
     ];
     let jobs: Vec<FitJob> = splits
         .iter()

@@ -648,6 +648,18 @@ pub enum NoiseProtocol {
     Clean,
 }
 
+impl NoiseProtocol {
+    /// Parses `clean`, `matched` or `train-clean-test-noisy` (the names `train --noise` takes).
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "clean" => Some(Self::Clean),
+            "matched" => Some(Self::Matched),
+            "train-clean-test-noisy" => Some(Self::TrainCleanTestNoisy),
+            _ => None,
+        }
+    }
+}
+
 /// A part of the samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Part {

@@ -64,6 +64,17 @@ impl Default for Split {
 }
 
 impl Split {
+    /// The leaky shuffled split at its fractions, 70 % training and 15 % validation (the rest
+    /// test), shuffled with `seed`: one definition for `train --split shuffled` and the
+    /// protocols experiment.
+    pub fn shuffled(seed: u64) -> Split {
+        Split::Shuffled {
+            train: 0.70,
+            val: 0.15,
+            seed,
+        }
+    }
+
     /// The protocol's default for a data set (spec learning.md §1.1): by seed when it has at
     /// least three (the last tests, the one before validates, the rest train), else
     /// 70/15/15 % blocks (say so: a data set of one seed cannot test on independent runs).

@@ -89,8 +89,7 @@ impl SimConfig {
     /// Nadal's flange-climb limit `(tan δ − μ)/(1 + μ·tan δ)` for the flange angle δ given
     /// here, else 70°.
     pub fn nadal_limit(&self, mu: f64) -> f64 {
-        let t = self.nadal_angle.unwrap_or(70f64.to_radians()).tan();
-        (t - mu) / (1.0 + mu * t)
+        crate::contact::nadal_limit(self.nadal_angle.unwrap_or(70f64.to_radians()), mu)
     }
 }
 
