@@ -495,3 +495,36 @@ fn one_point_and_misplaced_attachments_are_refused() {
         "{missing}"
     );
 }
+
+/// A data set whose manifest names an unknown noise reference is refused naming the field; it
+/// used to fall back to the default silently (issue 34). Without the field (older data sets)
+/// the rms reference they were made with is read.
+#[test]
+fn an_unknown_noise_reference_in_a_manifest_is_refused() {
+    use railforce::features::DataSet;
+    let dir = std::env::temp_dir().join(format!("railforce-snrref-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("r.csv"), "time_s,a\n0,1\n0.005,2\n").unwrap();
+    let manifest = |reference: &str| {
+        format!(
+            r#"{{"snr_db": 6.0, {reference} "runs": [{{"file": "r.csv", "condition": "c", "seed": 1}}]}}"#
+        )
+    };
+    std::fs::write(
+        dir.join("manifest.json"),
+        manifest(r#""snr_reference": "bogus","#),
+    )
+    .unwrap();
+    let e = DataSet::load(&dir).unwrap_err().to_string();
+    assert!(
+        e.contains("manifest.json") && e.contains("snr_reference") && e.contains("std or rms"),
+        "{e}"
+    );
+    std::fs::write(dir.join("manifest.json"), manifest("")).unwrap();
+    let ds = DataSet::load(&dir).unwrap();
+    assert_eq!(
+        ds.noise.map(|n| n.reference),
+        Some(railforce::sensors::SnrReference::Rms)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

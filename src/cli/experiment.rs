@@ -126,7 +126,8 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
     if args.last_label {
         opts.label_at = railforce::features::LabelAt::Last;
     }
-    opts.snr_reference = SnrReference::parse(&args.snr_reference).unwrap_or_default();
+    opts.snr_reference = SnrReference::parse(&args.snr_reference)
+        .ok_or_else(|| anyhow::anyhow!("--snr-reference {}: std or rms", args.snr_reference))?;
     if !(args.train_seeds.is_empty() && args.val_seeds.is_empty() && args.test_seeds.is_empty()) {
         if args.train_seeds.is_empty() || args.test_seeds.is_empty() {
             anyhow::bail!("give --train-seeds and --test-seeds (and --val-seeds) together");

@@ -82,12 +82,15 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         format,
         jobs,
         shard,
-        noise: args.snr_db.map(|snr| {
-            railforce::sensors::NoiseModel::new(
+        noise: match args.snr_db {
+            None => None,
+            Some(snr) => Some(railforce::sensors::NoiseModel::new(
                 snr,
-                railforce::sensors::SnrReference::parse(&args.snr_reference).unwrap_or_default(),
-            )
-        }),
+                railforce::sensors::SnrReference::parse(&args.snr_reference).ok_or_else(|| {
+                    anyhow::anyhow!("--snr-reference {}: std or rms", args.snr_reference)
+                })?,
+            )),
+        },
         settle: args.settle,
     };
     let total = dataset::runs(&plan)

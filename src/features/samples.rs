@@ -251,14 +251,23 @@ impl DataSet {
             (Some(fl), Some(fq)) => [fl.to_string(), fq.to_string()],
             _ => label_channels("1L"),
         };
-        let noise = m["snr_db"].as_f64().map(|snr| {
-            let reference = match m["snr_reference"].as_str() {
-                Some(r) => SnrReference::parse(r).unwrap_or_default(),
-                // Data sets written before the reference was recorded used the rms.
-                None => SnrReference::Rms,
-            };
-            NoiseModel::new(snr, reference)
-        });
+        let noise = match m["snr_db"].as_f64() {
+            None => None,
+            Some(snr) => {
+                let reference = match &m["snr_reference"] {
+                    // Data sets written before the reference was recorded used the rms.
+                    serde_json::Value::Null => SnrReference::Rms,
+                    r => r.as_str().and_then(SnrReference::parse).ok_or_else(|| {
+                        Error::config(
+                            &mpath,
+                            "snr_reference",
+                            format!("{r} is not a noise reference: std or rms"),
+                        )
+                    })?,
+                };
+                Some(NoiseModel::new(snr, reference))
+            }
+        };
         Ok(DataSet {
             dir: dir.to_path_buf(),
             names: names.unwrap_or_default(),
