@@ -11,17 +11,30 @@
 mod compare;
 pub mod criteria;
 pub mod ride;
+pub mod safety;
 pub mod statistics;
 
 use crate::dsp::{Butterworth, percentile};
 use crate::error::{Error, Result};
-use crate::identify::Identified;
-use crate::identify::safety::{Limits, indices};
 use crate::track::{SectionKind, TrackSpec};
 pub use compare::{StatCheck, compare};
 pub use criteria::Criteria;
+use safety::{Limits, indices};
 use serde::Serialize;
 use statistics::sliding_mean;
+
+/// A series of wheel–rail forces in time: the label time and one series per target, in N —
+/// what `identify` writes and the truth of a simulated run alike, so both are judged by the
+/// same statistics and indices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceSeries {
+    /// Target names (label channels).
+    pub targets: Vec<String>,
+    /// Time of each value, s (for identification, the label step of its window).
+    pub time: Vec<f64>,
+    /// Values `[n][targets]`, N.
+    pub values: Vec<Vec<f64>>,
+}
 
 /// Y and Q of one wheel over a run, N.
 #[derive(Debug, Clone)]
@@ -381,7 +394,7 @@ pub fn assess(
             }
         }
         // The Chinese criteria with their time criterion, through the one safety monitor.
-        let id = Identified {
+        let id = ForceSeries {
             targets: wheels
                 .iter()
                 .flat_map(|w| {
@@ -578,7 +591,7 @@ impl Assessment {
 impl RunForces {
     /// From identified (or true) forces at the label times and the track position at those
     /// times.
-    pub fn from_identified(id: &Identified, s: Vec<f64>) -> Result<Self> {
+    pub fn from_identified(id: &ForceSeries, s: Vec<f64>) -> Result<Self> {
         let cols: Vec<(String, Vec<f64>)> = [
             ("time_s".to_string(), id.time.clone()),
             ("s_m".to_string(), s),

@@ -6,7 +6,9 @@
 
 pub mod check_report;
 pub mod closed_loop;
-pub mod safety;
+/// The safety indices live in [`crate::assess::safety`] (assess judges any force series);
+/// re-exported here, where the streaming identification uses them.
+pub use crate::assess::safety;
 
 use crate::error::{Error, Result};
 use crate::features::{LabelAt, Part};
@@ -14,8 +16,8 @@ use crate::learn::model::Model;
 use crate::learn::windows::label_offset;
 use std::path::Path;
 
-/// Sampling rate the models are trained at, Hz.
-pub const RATE_HZ: f64 = 200.0;
+/// Sampling rate the models are trained at, Hz (the sensor contract's).
+pub use crate::sensors::RATE_HZ;
 
 /// Names accepted for the time column.
 pub const TIME_COLUMNS: [&str; 3] = ["time_s", "time", "t"];
@@ -231,16 +233,9 @@ fn interpolate(t: &[f64], v: &[f64], at: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Identified forces: the label time and one series per model target, in N.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Identified {
-    /// Target names (label channels).
-    pub targets: Vec<String>,
-    /// Time of each estimate, s (the label step of its window).
-    pub time: Vec<f64>,
-    /// Estimates `[n][targets]`, N.
-    pub values: Vec<Vec<f64>>,
-}
+/// Identified forces: the label time and one series per model target, in N (the force series
+/// that [`crate::assess`] judges).
+pub type Identified = crate::assess::ForceSeries;
 
 /// Identifies forces over a whole checked recording (one estimate per complete window).
 pub fn identify(model: &mut Model, input: &CheckedInput) -> Identified {

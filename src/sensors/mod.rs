@@ -7,6 +7,9 @@
 pub mod channels;
 pub mod noise;
 
+/// Sampling rate of every recorded channel and of the models trained on them, Hz.
+pub const RATE_HZ: f64 = 200.0;
+
 pub use channels::{
     Candidates, ChannelKind, PAPER_CHANNELS, PAPER_UNITS, clean_name, is_noisy, label_channels,
     noisy_name,

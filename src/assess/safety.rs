@@ -1,5 +1,6 @@
-//! Safety indices from identified forces (spec physics.md §7), with configurable limits whose
-//! defaults are the commonly quoted Chinese values — secondary-source figures, labelled so:
+//! Safety indices from a force series, identified or true (spec physics.md §7), with
+//! configurable limits whose defaults are the commonly quoted Chinese values — secondary-source
+//! figures, labelled so:
 //! derailment coefficient |Y|/Q ≤ 1.2 (allowable; 1.0 preferred), wheel unloading
 //! ΔQ/Q̄ ≤ 0.65 (0.60 preferred), wheelset lateral force H ≤ 0.85·(10 + P_st/3) kN, and a
 //! time criterion: an excursion above a limit counts when it lasts at least 50 ms (shorter
@@ -8,7 +9,8 @@
 //! One [`Monitor`] evaluates them sample by sample: the batch report ([`indices`]) and the
 //! streaming identification run the same code.
 
-use super::{Identified, RATE_HZ};
+use super::ForceSeries;
+use crate::sensors::RATE_HZ;
 use serde::{Deserialize, Serialize};
 
 /// Limits and the static load they refer to.
@@ -275,7 +277,7 @@ fn close(r: &mut IndexReport, open: Option<(f64, f64, f64)>, dt: f64, min: f64) 
 }
 
 /// Every index of an identification with its whole series (see [`Monitor::new`]).
-pub fn indices(id: &Identified, limits: &Limits) -> Vec<IndexReport> {
+pub fn indices(id: &ForceSeries, limits: &Limits) -> Vec<IndexReport> {
     let mut m = Monitor::new(&id.targets, limits, true);
     for (t, row) in id.time.iter().zip(&id.values) {
         m.push(*t, row);
@@ -289,7 +291,7 @@ mod tests {
 
     #[test]
     fn indices_and_exceedances() {
-        let id = Identified {
+        let id = ForceSeries {
             targets: vec!["w1l_force_y".into(), "w1l_force_z".into()],
             time: vec![0.0, 0.005, 0.010, 0.015],
             values: vec![
@@ -338,7 +340,7 @@ mod tests {
                 vec![y, 100e3]
             })
             .collect();
-        let id = Identified {
+        let id = ForceSeries {
             targets: vec!["w1l_force_y".into(), "w1l_force_z".into()],
             time,
             values,
