@@ -83,6 +83,10 @@ fn generate_resume_shard_merge_and_formats() {
     assert_eq!(kind("frame_l_acc_y_noisy").as_deref(), Some("input_noisy"));
     assert_eq!(kind("w3r_force_y").as_deref(), Some("wheel"));
     assert!(channels.iter().all(|c| c["unit"].is_string()));
+    // The manifest says how the runs were made: the integration step and settling time.
+    assert_eq!(m["integration"]["dt_s"], 2e-4);
+    assert!(m["integration"]["settle_s"].is_number());
+    assert!(m["integration"]["integrator"].is_string());
     let file = a.join("tangent_v80_seed1.npz");
     let bytes = std::fs::read(&file).unwrap();
     let cols = npz::read_npz(&bytes).unwrap();

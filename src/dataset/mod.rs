@@ -256,6 +256,16 @@ pub fn generate(
         "vehicle": {"file": plan.vehicle, "hash_fnv1a": file_hash(&plan.vehicle)?, "name": vehicle.name},
         "format": opts.format.ext(),
         "sampling_rate_hz": SimConfig::default().output_rate,
+        // How the runs were made, so a data set says how to regenerate it (issue 34).
+        "integration": {
+            "integrator": "semi-implicit Euler, fixed step (src/sim/mod.rs)",
+            "dt_s": SimConfig::default().dt,
+            "settle_s": opts.settle,
+            "anti_alias": format!(
+                "8th-order Butterworth low-pass at {} Hz at the integration rate, then decimated",
+                SimConfig::default().cutoff
+            ),
+        },
         "dataset": dataset,
         "snr_db": opts.noise.map(|n| n.snr_db),
         "snr_reference": opts.noise.map(|n| n.reference.name()),
