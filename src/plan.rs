@@ -3,7 +3,7 @@
 //! A plan names a vehicle, default duration and seeds, optional data-set options
 //! (`[dataset]`: a channel subset, float32 storage) and any number of `[[condition]]` tables
 //! (name, track file, speed, and optional overrides: vehicle, duration, seeds, irregularity
-//! class, start position). Paths are relative to the plan file; the README lists every key.
+//! class, start position). Paths are relative to the plan file; assets/docs/file-formats.md lists every key.
 
 use crate::error::{Error, Result};
 use serde::Deserialize;

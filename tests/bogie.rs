@@ -278,7 +278,7 @@ fn side_frame_hangs_roll_stiffness_about_the_pad_line() {
 /// The side frame swings as a pendulum under the bolster (the nest not sheared): a lateral
 /// force at the spring seat meets `(W·L + m·g·h + pads)/L²`. On pads without width or
 /// thickness that is W/L but for the frame's own weight: within 5 % loaded (0.8 %), 6 % empty;
-/// the C80's 25 mm pads add `N·t + k_y·t²` (README, "The K6 bogie as built").
+/// the C80's 25 mm pads add `N·t + k_y·t²` (assets/docs/physics.md §2).
 #[test]
 fn side_frame_swing_stiffness_is_w_over_l_loaded_and_empty() {
     for v in [c80(), c80_empty()] {
@@ -360,7 +360,7 @@ fn side_frame_rolled_and_let_go_returns() {
 
 /// The two-stage nest: the outer (and control) coils alone up to the inner coils' gap, then
 /// all; the empty wagon sits in the first stage and the loaded one in the second, from the
-/// same nest data, with 1.2 and 4.8 MN/m (spec physics.md §2).
+/// same nest data, with 1.2 and 4.8 MN/m (assets/docs/physics.md §2).
 #[test]
 fn two_stage_nest_engages_its_inner_coils_after_their_gap() {
     let nest = |v: &Vehicle| {
@@ -398,7 +398,7 @@ fn two_stage_nest_engages_its_inner_coils_after_their_gap() {
 
 /// K6 variable friction: the wedges' control springs press them on the column with
 /// `N = P/tan α`, the face slips at `μ·N`; the loaded wagon's friction is 8–10 % of its nest
-/// force (spec §2), the empty one's relatively more (its control springs stand taller).
+/// force (assets/docs/physics.md §2), the empty one's relatively more (its control springs stand taller).
 #[test]
 fn wedge_friction_comes_from_its_control_springs() {
     let wedge = |v: &Vehicle| {

@@ -185,7 +185,7 @@ fn s1002_on_60kg_conicity_grows_toward_flange_contact() {
 fn flange_back_sets_the_s1002_conicity() {
     // S1002 is drawn for a 1 360 mm flange back; at the Chinese 1 353 mm each wheel sits
     // 3.5 mm further out on its nearly flat tread, so the new-profile pair is almost
-    // cylindrical (README, validate dynamics: the hunting order depends on it).
+    // cylindrical (assets/docs/validation.md: the hunting order depends on it).
     let conicity = |back: f64| {
         let geo = WheelsetGeometry::new(
             profile::s1002(),

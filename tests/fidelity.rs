@@ -303,7 +303,7 @@ fn fidelity_checks_hold() {
         fidelity::yq_and_q(&fine, 8).unwrap(),
     );
     // Every wheel within 1 % (issue 17). Measured: leading 0.40 %, trailing 0.32 %; with the
-    // former 150 kg lateral rail mass the trailing ones were 2.85 % off (README).
+    // former 150 kg lateral rail mass the trailing ones were 2.85 % off (assets/docs/stability.md).
     let tol = 0.01;
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         assert!(
@@ -325,7 +325,7 @@ fn fidelity_checks_hold() {
     // hunts and its limit cycle dies out on the way down (measured 85 km/h); the empty one,
     // its bogies held by the cross-bracing and the sticking side bearers, does not hunt at
     // the files' conicity of 0.018. Issues 17 and 33 asked for the empty wagon first: it is,
-    // at 1 360 mm flange back (README, "Stability").
+    // at 1 360 mm flange back (assets/docs/stability.md).
     let smooth = fidelity::smooth(Path::new(&root().join("tracks/tangent.toml"))).unwrap();
     let empty = Vehicle::load(&root().join("vehicles/c80_empty.toml")).unwrap();
     let e = fidelity::critical_speed(&empty, &smooth, 200.0 / 3.6, 50.0 / 3.6, 2.0).unwrap();

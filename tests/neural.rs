@@ -34,7 +34,7 @@ fn loss(net: &mut Network, x: &[f32], y: &[f32], batch: usize) -> f64 {
 
 #[test]
 fn cnn_bilstm_has_the_spec_parameter_count() {
-    // Spec learning.md §3: 462 + 42 + 2816 + 256 + 24000 + 2624 + 520 + 9 = 30 729.
+    // assets/docs/learning.md §3: 462 + 42 + 2816 + 256 + 24000 + 2624 + 520 + 9 = 30 729.
     let net = Network::new(config(Architecture::CnnBiLstm, 21, 1, 0.2));
     assert_eq!(net.params.trainable_count(), 30_729);
     let both = Network::new(config(Architecture::CnnBiLstm, 21, 2, 0.2));

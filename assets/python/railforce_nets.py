@@ -5,7 +5,7 @@
     forces_n = net(x)   # x: [batch, window, channels] in physical units, channels in
                         # net.channels order; returns [batch, targets] in N
 
-The layers are the engine's (spec learning.md §3): an optional stem
+The layers are the engine's (assets/docs/learning.md §3): an optional stem
 Conv1d(C, C, 1) → LeakyReLU → BatchNorm1d → Conv1d(C, 128, 1) → LeakyReLU → BatchNorm1d →
 MaxPool1d(2, stride 1); then a BiLSTM (20 per direction, final states of both directions),
 a GRU (20, final state) or the flattened stem; then the head Linear(F, 64) → LeakyReLU →

@@ -1,4 +1,4 @@
-//! Safety indices from a force series, identified or true (spec physics.md §7), with
+//! Safety indices from a force series, identified or true (assets/docs/physics.md §7), with
 //! configurable limits whose defaults are the commonly quoted Chinese values — secondary-source
 //! figures, labelled so:
 //! derailment coefficient |Y|/Q ≤ 1.2 (allowable; 1.0 preferred), wheel unloading

@@ -186,7 +186,7 @@ fn row(t: f64, position: Option<f64>, forces: &[f64], indices: &[f64]) -> String
 fn write_safety_json(out: &Path, reports: &[IndexReport], limits: &Limits) -> Result<PathBuf> {
     let json = serde_json::to_string_pretty(&serde_json::json!({
         "limits": limits,
-        "limits_source": "commonly quoted Chinese values (secondary sources, spec physics.md §7)",
+        "limits_source": "commonly quoted Chinese values (secondary sources, assets/docs/physics.md §7)",
         "indices": reports,
     }))?;
     let sp = out.with_extension("safety.json");

@@ -73,7 +73,7 @@ enum Command {
     /// the rest; files are written atomically. `--snr-db X` adds `<channel>_noisy` copies of
     /// the 21 input channels (white Gaussian noise at X dB, seeded); labels are never noised.
     /// The plan file's keys (per-condition vehicle, class, seeds, start; [dataset] channel
-    /// subset and float32) are listed in the README, "Plan files".
+    /// subset and float32) are listed in assets/docs/file-formats.md, "Plan files".
     #[command(
         after_help = "Examples:\n  railforce generate --plan demo --out data/demo --snr-db 6\n  (the paper's 34 conditions, 136 runs: railforce generate --plan paper34 --out data/paper34 --snr-db 6)"
     )]
@@ -124,7 +124,7 @@ enum Command {
     /// runs), 6 dB with σ from each channel's std, centre label. Writes tables (Markdown,
     /// CSV), SVG figures and index.html with the paper's numbers beside ours. The full
     /// protocol on the paper's 34 conditions (`experiment all --plan paper34`) takes about an
-    /// hour on two cores; the README lists what each part measured.
+    /// hour on two cores; assets/docs/results.md lists what each part measured.
     #[command(
         after_help = "Examples:\n  railforce experiment comparison --plan demo --out experiments --epochs 2 --windows-per-epoch 2000"
     )]

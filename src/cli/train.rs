@@ -106,8 +106,8 @@ pub struct TrainArgs {
     #[arg(long, conflicts_with = "resume")]
     force: bool,
     /// Networks, matched protocol: learn the data set's one fixed noise realisation instead of
-    /// drawing new training-input noise every epoch at its SNR (the default, the spec's and
-    /// the experiments' protocol; validation and test always keep the data set's noisy
+    /// drawing new training-input noise every epoch at its SNR (the default, the protocol of
+    /// assets/docs/learning.md §1.4 and the experiments; validation and test always keep the data set's noisy
     /// columns).
     #[arg(long)]
     fixed_noise: bool,
@@ -336,7 +336,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         println!(
             "  training noise: {}",
             if opts.fresh_noise.is_some() {
-                "a new draw every epoch (the spec's protocol; --fixed-noise to learn the data set's one realisation)"
+                "a new draw every epoch (the default protocol; --fixed-noise to learn the data set's one realisation)"
             } else {
                 "the data set's one fixed realisation"
             }

@@ -50,7 +50,7 @@ enum What {
         #[arg(long)]
         reference_dir: Option<PathBuf>,
     },
-    /// The simulator's physics checks (spec §6): static wheel loads, quasi-static curving
+    /// The simulator's physics checks (assets/docs/validation.md): static wheel loads, quasi-static curving
     /// forces on R 400 m at 60 km/h and R 800 m at 100 km/h, Klingel's wavelength of a free
     /// wheelset and Wickens' critical speed of a restrained one; then fidelity: the
     /// anti-alias filter at the output's Nyquist frequency, wheel-force power above 40 Hz in
@@ -478,7 +478,7 @@ fn contact(dir: &cv::Reference) -> Result<()> {
         );
     }
     println!(
-        "worst: Polach vs exact {:.4} μFn (spec target 0.03, gate {}), FASTSIM vs FASTSIM {:.4} μFn (gate {})",
+        "worst: Polach vs exact {:.4} μFn (target 0.03, gate {}), FASTSIM vs FASTSIM {:.4} μFn (gate {})",
         worst[0],
         cv::POLACH_TOLERANCE,
         worst[1],

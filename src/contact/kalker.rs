@@ -1,5 +1,5 @@
-//! Kalker's creepage coefficients C11, C22, C23, C33 (Kalker 1967, as tabulated in the spec
-//! §4.4), interpolated linearly in the ellipse ratio and in ν by
+//! Kalker's creepage coefficients C11, C22, C23, C33 (Kalker 1967; the table is in
+//! `TABLE_AB_LE_1` and `TABLE_AB_GT_1` below, assets/docs/physics.md §4), interpolated linearly in the ellipse ratio and in ν by
 //! `1/C(ν) = 8(ν−¼)(ν−½)/C(0) − 16ν(ν−½)/C(¼) + 8ν(ν−¼)/C(½)`.
 
 /// Kalker's coefficients for one ellipse ratio and Poisson ratio.
@@ -161,7 +161,7 @@ const TABLE_AB_GT_1: [Row; 9] = [
     ),
 ];
 
-/// Value at Poisson ratio ν from the three tabulated values (interpolation of 1/C, spec §4.4).
+/// Value at Poisson ratio ν from the three tabulated values (interpolation of 1/C, assets/docs/physics.md §4).
 fn in_nu(c: [f64; 3], nu: f64) -> f64 {
     let inv = 8.0 * (nu - 0.25) * (nu - 0.5) / c[0] - 16.0 * nu * (nu - 0.5) / c[1]
         + 8.0 * nu * (nu - 0.25) / c[2];

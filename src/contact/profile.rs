@@ -238,7 +238,7 @@ impl CubicSpline {
     }
 }
 
-/// The S1002 wheel (EN 13715) from its analytic definition (spec §4.1), over
+/// The S1002 wheel (EN 13715) from its analytic definition (assets/docs/physics.md §4), over
 /// `−69.5 mm ≤ y ≤ 60 mm` (the flange back's vertical tangent at −70 mm is left out).
 pub fn s1002() -> Profile {
     Profile::from_fn("S1002", -69.5e-3, 60e-3, |y| {
@@ -308,8 +308,8 @@ fn s1002_mm(y: f64) -> (f64, f64, f64) {
     }
 }
 
-/// The 60 kg/m rail head (CHN60 / 60E1 family), upright (not inclined), from its arcs (spec
-/// §4.1): crown R300 to |y| = 10.228 mm, R80 to 26.027 mm, R13 down to the 1:20 flank, flank
+/// The 60 kg/m rail head (CHN60 / 60E1 family), upright (not inclined), from its arcs
+/// (assets/docs/physics.md §4): crown R300 to |y| = 10.228 mm, R80 to 26.027 mm, R13 down to the 1:20 flank, flank
 /// to 35 mm below the top. Symmetric about `y = 0`; `z` is the depth below the crown.
 pub fn rail_60kg() -> Profile {
     // Each arc is tangent to the previous: its centre lies on the previous arc's normal.

@@ -14,8 +14,8 @@ use serde::Deserialize;
 pub const POSITION_TOLERANCE: f64 = 1e-3;
 /// Tolerance on the contact angle, rad (2°).
 pub const ANGLE_TOLERANCE: f64 = 2.0 * std::f64::consts::PI / 180.0;
-/// Tolerance of Polach against Kalker's exact theory, in units of μ·Fn. The spec asks for
-/// 0.03; Polach's 1999 formula itself departs by up to ≈ 0.061 near ξ = 0.0028 on this case,
+/// Tolerance of Polach against Kalker's exact theory, in units of μ·Fn. The project's
+/// target was 0.03; Polach's 1999 formula itself departs by up to ≈ 0.061 near ξ = 0.0028 on this case,
 /// so that bound is reported as a miss, and the gate is the law's own accuracy, 0.065.
 pub const POLACH_TOLERANCE: f64 = 0.065;
 /// Tolerance of FASTSIM against CONTACT's FASTSIM, in units of μ·Fn.

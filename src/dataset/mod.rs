@@ -67,7 +67,7 @@ pub struct GenerateOptions {
     /// This shard `(i, n)`, 1-based: runs with index `k` where `k % n == i − 1`.
     pub shard: Option<(usize, usize)>,
     /// Add noised copies (`<channel>_noisy`) of the paper's input channels with this noise
-    /// model (spec learning.md §1.4).
+    /// model (assets/docs/learning.md §1.4).
     pub noise: Option<NoiseModel>,
     /// Settling time of each run, s.
     pub settle: f64,

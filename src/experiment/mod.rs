@@ -1,4 +1,4 @@
-//! The paper's experiments on railforce data (spec learning.md §4), and two of ours: model
+//! The paper's experiments on railforce data (assets/docs/learning.md §4), and two of ours: model
 //! comparison, generalisation over conditions (with leave-one-condition-out, which the paper
 //! never ran), robustness to noise under both noise protocols, the protocols side by side, and
 //! on-board sensor selection. Defaults: the plan's seeds split by seed (independent test runs),
@@ -122,7 +122,7 @@ pub struct ExperimentOptions {
 }
 
 impl ExperimentOptions {
-    /// The full protocol of the experiments (spec learning.md §4).
+    /// The full protocol of the experiments (assets/docs/learning.md §4).
     pub fn full(plan: PathBuf, out: PathBuf) -> Self {
         ExperimentOptions {
             plan,

@@ -1,5 +1,5 @@
 //! Beyond the paper: the CNN-BiLSTM under the seed, block, condition and shuffled splits side
-//! by side (spec learning.md §4.4), so a reader sees what each number measures and how much a
+//! by side (assets/docs/learning.md §4.4), so a reader sees what each number measures and how much a
 //! leaky split inflates it.
 
 use super::{Ctx, FitJob, f4};

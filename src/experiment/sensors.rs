@@ -1,4 +1,4 @@
-//! Beyond the paper: sensor selection (spec learning.md §4.5). The Filter–Wrapper runs over
+//! Beyond the paper: sensor selection (assets/docs/learning.md §4.5). The Filter–Wrapper runs over
 //! every on-board candidate signal for FL and for FQ (on the training and validation runs,
 //! noisy at the experiments' SNR); the CNN-BiLSTM on the union of the two selections is
 //! compared with the paper's 21 at each SNR of the experiment.

@@ -91,7 +91,7 @@ impl Default for SelectOptions {
     }
 }
 
-/// Filter (MI of each candidate with the target over the training rows, spec learning.md §2),
+/// Filter (MI of each candidate with the target over the training rows, assets/docs/learning.md §2),
 /// then wrapper (forward selection by validation R² of ridge on flattened windows).
 pub fn select(ds: &DataSet, split: &Split, opts: &SelectOptions) -> Result<Selection> {
     let target_name = ds.target_channel(&opts.target);

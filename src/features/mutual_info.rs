@@ -87,7 +87,7 @@ fn count_within(sorted: &[f64], c: f64, e: f64) -> usize {
     hi - lo
 }
 
-/// KSG estimate of I(X; Y) in nats with `k` neighbours (k = 3 in the spec).
+/// KSG estimate of I(X; Y) in nats with `k` neighbours (k = 3 by default, assets/docs/learning.md §2).
 pub fn mutual_information(x: &[f64], y: &[f64], k: usize) -> f64 {
     let n = x.len().min(y.len());
     if n <= k + 1 {

@@ -1,4 +1,4 @@
-//! Samples (spec learning.md §1): split first, window second. The default test is a set of
+//! Samples (assets/docs/learning.md §1): split first, window second. The default test is a set of
 //! independent runs: whole runs of irregularity seeds the model never saw ([`Split::Seeds`]).
 //! Runs can also be cut into contiguous blocks, whole conditions held out, or (labelled as
 //! leaky, for comparison only) stride-1 windows shuffled. Windows of `window` steps never
@@ -646,7 +646,7 @@ impl ZScore {
     }
 }
 
-/// Which inputs each part reads when the data set has `_noisy` copies (spec learning.md §1.4).
+/// Which inputs each part reads when the data set has `_noisy` copies (assets/docs/learning.md §1.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum NoiseProtocol {
     /// Train and validate on clean inputs, test on noisy ones.

@@ -1,5 +1,5 @@
-//! How the runs of a data set are split into training, validation and test parts (spec
-//! learning.md §1.1): by seed (the default), in contiguous blocks, by condition, or
+//! How the runs of a data set are split into training, validation and test parts
+//! (assets/docs/learning.md §1.1): by seed (the default), in contiguous blocks, by condition, or
 //! shuffled (leaky, labelled so).
 
 use super::samples::DataSet;
@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Split {
-    /// Whole runs by irregularity seed (the default, spec learning.md §1.1): a seed never
+    /// Whole runs by irregularity seed (the default, assets/docs/learning.md §1.1): a seed never
     /// serves two parts; the test runs are independent stretches of track.
     Seeds {
         /// Training seeds.
@@ -75,7 +75,7 @@ impl Split {
         }
     }
 
-    /// The protocol's default for a data set (spec learning.md §1.1): by seed when it has at
+    /// The protocol's default for a data set (assets/docs/learning.md §1.1): by seed when it has at
     /// least three (the last tests, the one before validates, the rest train), else
     /// 70/15/15 % blocks (say so: a data set of one seed cannot test on independent runs).
     pub fn standard(ds: &DataSet) -> Split {

@@ -225,7 +225,7 @@ pub fn tanh_into(src: &[f32], dst: &mut [f32]) {
     }
 }
 
-/// Leaky ReLU slope below zero (spec learning.md §3).
+/// Leaky ReLU slope below zero (assets/docs/learning.md §3).
 pub const LEAKY_SLOPE: f32 = 0.01;
 
 /// In-place leaky ReLU.

@@ -1,4 +1,4 @@
-//! Test metrics (spec learning.md §1.5): MSE and R² on standardised targets, RMSE and MAE in
+//! Test metrics (assets/docs/learning.md §1.5): MSE and R² on standardised targets, RMSE and MAE in
 //! kN, and Var(y_test) beside them (MSE and R² only compare through it).
 
 use crate::features::ZScore;

@@ -1,7 +1,7 @@
 //! Standardised windows ready for the learners: each run's selected input columns interleaved
 //! row-major (`[rows × C]` f32, so a window is one contiguous slice) and its standardised
 //! targets. Built per part from the leak-free [`Samples`] with the statistics of the training
-//! blocks only (spec learning.md §1).
+//! blocks only (assets/docs/learning.md §1).
 
 use crate::error::{Error, Result};
 use crate::features::{DataSet, LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
@@ -216,7 +216,7 @@ pub fn prepare(
 
 /// Fresh input noise for the training windows, one draw per epoch (matched protocol): the
 /// clean inputs plus white Gaussian noise with the σ of [`NoiseModel::sigma`] per run and
-/// channel, exactly the data set's noise model (spec learning.md §1.4), in the training
+/// channel, exactly the data set's noise model (assets/docs/learning.md §1.4), in the training
 /// view's standardisation. A network trained on one fixed noise realisation learns that
 /// realisation (the training loss keeps falling while the validation loss stalls); a new
 /// draw every epoch leaves it only the signal. Validation and test keep the data set's

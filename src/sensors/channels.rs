@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Names of the paper's 21 input channels, in order X1 … X21 (spec physics.md §5). The three
+/// Names of the paper's 21 input channels, in order X1 … X21 (assets/docs/physics.md §5). The three
 /// creepages and the angle of attack are those of the label wheel (1L in the paper).
 pub const PAPER_CHANNELS: [&str; 21] = [
     "frame_l_acc_y",
@@ -139,7 +139,7 @@ impl ChannelKind {
     }
 }
 
-/// Which signals feature selection chooses from (spec learning.md §2).
+/// Which signals feature selection chooses from (assets/docs/learning.md §2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Candidates {

@@ -2,7 +2,7 @@
 //! and kinds ([`channels`]), the paper's 21 inputs, the label wheel's force channels, the
 //! on-board candidate signals the Filter–Wrapper may choose from, the `_noisy` naming, and the
 //! one noise model ([`noise`]) that `generate`, training's fresh noise, the experiments and
-//! `validate identify` all use (spec learning.md §1.4, §2; physics.md §5).
+//! `validate identify` all use (assets/docs/learning.md §1.4, §2; physics.md §5).
 
 pub mod channels;
 pub mod noise;

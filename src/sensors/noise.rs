@@ -1,4 +1,4 @@
-//! The one sensor-noise model (spec learning.md §1.4): additive white Gaussian noise per input
+//! The one sensor-noise model (assets/docs/learning.md §1.4): additive white Gaussian noise per input
 //! channel, `σ_c = ref_c · 10^(−SNR/20)`, where `ref_c` is the channel's standard deviation
 //! over the run (its variation, the default) or its root mean square (offset included, the
 //! former definition, kept as an option). Seeded from the run's seed and the channel's name,

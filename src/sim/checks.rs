@@ -1,4 +1,4 @@
-//! Checks a correct simulator passes (spec §6): static wheel loads, quasi-static curving
+//! Checks a correct simulator passes (assets/docs/physics.md §6, assets/docs/validation.md): static wheel loads, quasi-static curving
 //! forces, and Klingel's kinematic oscillation of a free wheelset. Used by
 //! `railforce validate dynamics` and by the test suite.
 

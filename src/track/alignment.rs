@@ -3,7 +3,7 @@
 //! Curvature is piecewise linear in `s` (constant on tangents and curves, linear on clothoid
 //! transitions), so the heading is piecewise quadratic and known in closed form; the plane
 //! position is its integral, evaluated with Gauss–Legendre quadrature from tabulated nodes.
-//! Sign conventions (spec §1): curvature is positive for a curve to the **left**; the signed
+//! Sign conventions (assets/docs/conventions.md): curvature is positive for a curve to the **left**; the signed
 //! cant is positive when the **left** rail is higher (a right-hand curve raises the left rail).
 
 /// Direction of a curve seen in the running direction.

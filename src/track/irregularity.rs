@@ -1,4 +1,4 @@
-//! Track irregularities from the US FRA track-class PSDs (spec §3.2).
+//! Track irregularities from the US FRA track-class PSDs (assets/docs/physics.md §3.2).
 //!
 //! One-sided PSDs in cm²/(rad/m), Ω in rad/m, k = 0.25:
 //! vertical profile and alignment `k·A·Ω_c²/(Ω²(Ω² + Ω_c²))`, cross-level and gauge
@@ -33,7 +33,7 @@ pub struct FraClass {
     pub omega_c: f64,
 }
 
-/// (A_v, A_a, Ω_s, Ω_c) for classes 1–6 (FRA, as tabulated in spec §3.2).
+/// (A_v, A_a, Ω_s, Ω_c) for classes 1–6 (FRA, as tabulated in assets/docs/physics.md §3.2).
 const FRA_TABLE: [(f64, f64, f64, f64); 6] = [
     (1.2107, 3.3634, 0.6046, 0.8245),
     (1.0181, 1.2107, 0.9308, 0.8245),

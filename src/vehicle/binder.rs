@@ -48,8 +48,8 @@ impl Binder<'_> {
     /// `lower_at` on the lower one (vehicle frame, m, static loaded position), and the rest
     /// offset `lower_at − upper_at` the element measures its displacement from. The one-point
     /// `at` of older files is refused with what to write instead: an element acting at one
-    /// point for both bodies put the side frames' pads and nests at the wrong heights (spec
-    /// physics.md §2). Each point must lie on its body (within its inertia box grown by
+    /// point for both bodies put the side frames' pads and nests at the wrong heights
+    /// (assets/docs/physics.md §2). Each point must lie on its body (within its inertia box grown by
     /// [`Self::REACH`]) and the two no more than [`Self::SPAN`] apart.
     pub fn pair(
         &self,
@@ -64,7 +64,7 @@ impl Binder<'_> {
             return Err(self.err(
                 format!("{f}.at"),
                 format!(
-                    "one point for both bodies is no longer read: write `upper_at` (where the element meets \"{upper}\") and `lower_at` (where it meets \"{lower}\"), e.g. upper_at = {p:?} and lower_at = {p:?} if they truly meet there (README, vehicle files)"
+                    "one point for both bodies is no longer read: write `upper_at` (where the element meets \"{upper}\") and `lower_at` (where it meets \"{lower}\"), e.g. upper_at = {p:?} and lower_at = {p:?} if they truly meet there (assets/docs/file-formats.md, vehicle files)"
                 ),
             ));
         }

@@ -74,7 +74,7 @@ pub struct Hauling {
     pub integral: f64,
 }
 
-/// What the virtual accelerometers read (spec physics.md §5 lets either be chosen, once).
+/// What the virtual accelerometers read (assets/docs/physics.md §5 lets either be chosen, once).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Accelerometers {
     /// Specific force `a − g` in body axes (what a DC accelerometer reads): +9.81 m/s²
@@ -84,7 +84,7 @@ pub enum Accelerometers {
     SpecificForce,
     /// Kinematic acceleration `a` in body axes, gravity excluded (a multibody code's
     /// acceleration output): 0 at rest. Loses the body's tilt against gravity, hence the
-    /// load transfer (README, "Vehicle files").
+    /// load transfer (assets/docs/physics.md §2).
     Kinematic,
 }
 
@@ -182,7 +182,7 @@ impl Vehicle {
     /// The same vehicle with its wheelsets' flange back-to-back distance changed by `delta`
     /// (m; the tape circles move out by half of it each). S1002's equivalent conicity turns
     /// with it (0.018 at the Chinese 1 353 mm, 0.18 at its design 1 360 mm), and so does the
-    /// hunting (README, "Stability").
+    /// hunting (assets/docs/stability.md).
     pub fn with_flange_back_changed(&self, delta: f64) -> Vehicle {
         let mut v = self.clone();
         v.contact.geometry.tape_circle_half += 0.5 * delta;

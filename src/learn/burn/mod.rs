@@ -1,5 +1,5 @@
 //! The four networks as burn modules (<https://burn.dev>, 0.22): the fused engine's layer table
-//! (spec learning.md §3) built from burn-nn's `Linear`, `BatchNorm`, `BiLstm` and `Gru`, so a
+//! (assets/docs/learning.md §3) built from burn-nn's `Linear`, `BatchNorm`, `BiLstm` and `Gru`, so a
 //! user can change or add a layer without writing its backward pass, and burn's autodiff is an
 //! independent check of the engine's hand-written gradients (`tests/neural.rs`).
 //!

@@ -1,6 +1,6 @@
 //! Gradient boosting of regression trees on squared loss (Friedman 2001), with histogram
 //! splits: the GBDT (100 trees, depth 3, λ = 0) and XGBoost-style (300 trees, depth 6, λ = 1)
-//! settings of the spec, and a single tree (learning rate 1, one round).
+//! settings of assets/docs/learning.md §3, and a single tree (learning rate 1, one round).
 
 use super::binning::Bins;
 use super::tree::{Tree, TreeParams};

@@ -1,6 +1,6 @@
 //! Classical regressors on flattened windows (`window × channels` features): SVR (RBF), GBDT,
-//! XGBoost-style histogram boosting and a decision tree (spec learning.md §3). Written here
-//! rather than taken from a crate; see the README for the measurements behind that.
+//! XGBoost-style histogram boosting and a decision tree (assets/docs/learning.md §3). Written here
+//! rather than taken from a crate; see assets/docs/results.md (learning engine) for the measurements behind that.
 
 pub mod binning;
 pub mod boosting;

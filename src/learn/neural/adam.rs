@@ -23,7 +23,7 @@ pub struct Adam {
 }
 
 impl Adam {
-    /// Adam with the spec's settings (lr 1e-3, betas 0.9/0.999, ε 1e-8).
+    /// Adam with the settings of assets/docs/learning.md §3 (lr 1e-3, betas 0.9/0.999, ε 1e-8).
     pub fn new(len: usize, lr: f32) -> Self {
         Adam {
             lr,

@@ -1,5 +1,5 @@
 //! Fully connected layer on rows: `y = x·W + b` with `W[in×out]`. Applied to `[B·T, C]` rows
-//! it is exactly a Conv1d with kernel 1 over time (spec learning.md §3, layers 1 and 3).
+//! it is exactly a Conv1d with kernel 1 over time (assets/docs/assets/docs/learning.md §3, layers 1 and 3).
 
 use super::params::ParamSet;
 use crate::learn::linalg::{add_col_sums, affine, affine_backward};

@@ -1,11 +1,11 @@
-//! Bidirectional LSTM returning the final state of each direction (spec learning.md §3,
+//! Bidirectional LSTM returning the final state of each direction (assets/docs/learning.md §3,
 //! layer 6): the forward state after the last step and the backward state after consuming the
 //! whole window, concatenated to `[B, 2H]`.
 //!
 //! The input projection of all steps and both directions is one matrix product
 //! `[B·T, D]·[D, 8H]` (three quarters of the cost); the recurrence then adds `h·W_hh` step by
 //! step. Gates in PyTorch order (i, f, g, o); two bias vectors as PyTorch (b_ih, b_hh), so the
-//! parameter count is the spec's 24 000 for D = 128, H = 20.
+//! parameter count is the 24 000 of assets/docs/learning.md §3 for D = 128, H = 20.
 
 use super::params::ParamSet;
 use crate::learn::linalg::{

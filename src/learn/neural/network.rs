@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Architecture {
-    /// The paper's CNN-BiLSTM (spec learning.md §3).
+    /// The paper's CNN-BiLSTM (assets/docs/learning.md §3).
     CnnBiLstm,
     /// The convolutional stem, flattened, and the head.
     Cnn,

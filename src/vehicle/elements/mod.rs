@@ -9,7 +9,7 @@
 //! action, so the pair of forces has a couple `(p_lower − p_upper) × F`; the upper body carries
 //! it (as the clamped top of a coil spring carries its shear couple), so the lower body feels
 //! the force exactly where it meets the element: a side frame loaded at its spring seat and
-//! carried at its pedestal roofs hangs, as built (spec physics.md §2).
+//! carried at its pedestal roofs hangs, as built (assets/docs/physics.md §2).
 
 mod centre_plate;
 mod cross_bracing;
@@ -86,7 +86,7 @@ impl Element {
 
     /// Relative displacement across the element from its static loaded position, in the upper
     /// body's axes (lower attachment relative to the upper: `+z` compresses a supporting
-    /// element), for the kinds that carry a displacement gauge (spec physics.md §5).
+    /// element), for the kinds that carry a displacement gauge (assets/docs/physics.md §5).
     pub fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
         match self {
             Element::ShearPad(e) => Some(e.relative(states).d),

@@ -5,7 +5,7 @@
 //! (part of the nest, taller than the outer coils), whose force P presses it through its sloped
 //! face against the column with `N = P / tan α` (α the slope's angle from the vertical column
 //! face; friction on the slope neglected, so up and down strokes damp alike); the column face
-//! slips at `μ·N` (spec physics.md §2). The control springs' extra height keeps them loaded
+//! slips at `μ·N` (assets/docs/physics.md §2). The control springs' extra height keeps them loaded
 //! when the empty wagon barely compresses the load springs: relatively more friction empty.
 //!
 //! - Column face (lateral y, vertical z of the bolster): force `k_s·(d − s) + c_s·v`, with the
