@@ -100,7 +100,8 @@ fn seeds(path: &Path, field: &str, s: SeedsFile) -> Result<Vec<u64>> {
 }
 
 /// Data-set options of a plan (`[dataset]`), recorded in the manifest.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct DatasetOptions {
     /// Channels to keep, by name or kind (`input`, `input_noisy`, `label`, `wheel`, `truth`
     /// …, see the manifest's `channels`); `time_s`, `s_m` and the labels are always kept.

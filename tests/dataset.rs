@@ -2,7 +2,7 @@
 
 mod common;
 
-use railforce::dataset::{self, Event, Format, GenerateOptions, npz};
+use railforce::dataset::{self, Event, Format, GenerateOptions, Manifest, npz};
 use railforce::plan::Plan;
 use railforce::sensors::{NoiseModel, SnrReference};
 use std::path::{Path, PathBuf};
@@ -49,7 +49,11 @@ fn opts(out: &Path, format: Format, shard: Option<(usize, usize)>) -> GenerateOp
 fn run_events(plan: &Plan, o: &GenerateOptions) -> (serde_json::Value, Vec<Event>) {
     let events = Mutex::new(Vec::new());
     let m = dataset::generate(plan, o, &|e| events.lock().unwrap().push(e)).unwrap();
-    (m, events.into_inner().unwrap())
+    // The typed manifest as it is on disk.
+    (
+        serde_json::to_value(&m).unwrap(),
+        events.into_inner().unwrap(),
+    )
 }
 
 fn started(events: &[Event]) -> usize {
@@ -130,7 +134,7 @@ fn generate_resume_shard_merge_and_formats() {
     let b = dir.join("b");
     run_events(&plan, &opts(&b, Format::Npz, Some((1, 2))));
     run_events(&plan, &opts(&b, Format::Npz, Some((2, 2))));
-    let merged = dataset::merge(&b).unwrap();
+    let merged = serde_json::to_value(dataset::merge(&b).unwrap()).unwrap();
     let strip = |m: &serde_json::Value| {
         m["runs"]
             .as_array()
@@ -356,8 +360,8 @@ fn float32_subset_keeps_values_to_float32_precision() {
     assert_eq!(m["dataset"]["float32"], true);
     assert_eq!(m["runs"][0]["class"], 4);
     let (da, db) = (
-        railforce::features::DataSet::load(&a).unwrap(),
-        railforce::features::DataSet::load(&b).unwrap(),
+        railforce::dataset::DataSet::load(&a).unwrap(),
+        railforce::dataset::DataSet::load(&b).unwrap(),
     );
     assert!(db.names.len() < da.names.len());
     for n in [
@@ -408,4 +412,88 @@ fn float32_subset_keeps_values_to_float32_precision() {
         err.contains("data-set options") && err.contains("another --out"),
         "{err}"
     );
+}
+
+/// The typed manifest reads every manifest the previous code wrote: today's format (written
+/// back byte for byte), the 2026-11-27 one without `integration`, and the first writer's of
+/// 2026-11-22 without the data-set options, the noise reference, the accelerometer setting,
+/// the label wheel and each run's vehicle, class and start.
+#[test]
+fn typed_manifest_reads_every_format() {
+    let dir = root().join("tests/fixtures/manifests");
+    let today = dir.join("2026-12-01.json");
+    let m = Manifest::read(&today).unwrap().unwrap();
+    let integration = m.integration.as_ref().unwrap();
+    assert_eq!(integration.dt_s, 2e-4);
+    assert_eq!(m.labels(), ["w1l_force_y", "w1l_force_z"]);
+    assert_eq!(
+        m.conventions.labels.as_ref().unwrap().wheel.as_deref(),
+        Some("1L")
+    );
+    let noise = m.noise_model(&today).unwrap().unwrap();
+    assert_eq!((noise.snr_db, noise.reference), (6.0, SnrReference::Std));
+    assert_eq!(m.runs.len(), 2);
+    assert_eq!(m.runs[0].vehicle.as_deref(), Some("C80 loaded (100 t)"));
+    let tmp = temp("manifest_round_trip");
+    let back = tmp.join("manifest.json");
+    m.write(&back).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(&back).unwrap(),
+        std::fs::read_to_string(&today).unwrap(),
+        "the typed manifest writes the untyped writer's bytes"
+    );
+
+    let nov27 = Manifest::read(&dir.join("2026-11-27.json"))
+        .unwrap()
+        .unwrap();
+    assert!(nov27.integration.is_none());
+    assert_eq!(nov27.runs, m.runs);
+
+    let first = dir.join("2026-11-22.json");
+    let old = Manifest::read(&first).unwrap().unwrap();
+    assert_eq!(old.dataset, railforce::plan::DatasetOptions::default());
+    assert_eq!(old.labels(), ["w1l_force_y", "w1l_force_z"]);
+    assert!(old.conventions.accelerometers.is_none());
+    assert!(
+        old.runs
+            .iter()
+            .all(|r| r.vehicle.is_none() && r.class.is_none())
+    );
+    // No reference recorded with an SNR: the rms, as that writer's noise said.
+    let noise = old.noise_model(&first).unwrap().unwrap();
+    assert_eq!(noise.reference, SnrReference::Rms);
+}
+
+/// A manifest field that is there but cannot be read is an error naming the file and the
+/// field, never a silent default.
+#[test]
+fn unreadable_manifest_field_is_named() {
+    let text =
+        std::fs::read_to_string(root().join("tests/fixtures/manifests/2026-12-01.json")).unwrap();
+    let tmp = temp("manifest_bad_field");
+    for (from, to, field) in [
+        ("\"snr_db\": 6.0", "\"snr_db\": \"six\"", "snr_db"),
+        ("\"seed\": 4", "\"seed\": -4", "seed"),
+        ("\"dt_s\": 0.0002", "\"dt_s\": [0.0002]", "dt_s"),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let path = tmp.join("manifest.json");
+        std::fs::write(&path, text.replacen(from, to, 1)).unwrap();
+        let e = Manifest::read(&path).unwrap_err().to_string();
+        assert!(e.contains("manifest.json"), "{e}");
+        assert!(e.contains(&format!("field \"{field}\"")), "{e}");
+    }
+    let path = tmp.join("manifest.json");
+    std::fs::write(
+        &path,
+        text.replacen(
+            "\"snr_reference\": \"std\"",
+            "\"snr_reference\": \"peak\"",
+            1,
+        ),
+    )
+    .unwrap();
+    let m = Manifest::read(&path).unwrap().unwrap();
+    let e = m.noise_model(&path).unwrap_err().to_string();
+    assert!(e.contains("snr_reference") && e.contains("peak"), "{e}");
 }

@@ -1,9 +1,8 @@
 //! Samples and feature selection: leak-free windows, training-only statistics, noise
 //! protocols, and a wrapper that finds the informative channels of a known problem.
 
-use railforce::features::{
-    self, DataSet, LabelAt, NoiseProtocol, Part, Run, SelectOptions, Split, ZScore,
-};
+use railforce::dataset::{DataSet, Run};
+use railforce::features::{self, LabelAt, NoiseProtocol, Part, SelectOptions, Split, ZScore};
 use railforce::sensors::PAPER_CHANNELS;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;

@@ -1,6 +1,7 @@
 //! Identification: input checks, agreement with evaluation, streaming equals batch.
 
-use railforce::features::{DataSet, LabelAt, NoiseProtocol, Run, Split};
+use railforce::dataset::{DataSet, Run};
+use railforce::features::{LabelAt, NoiseProtocol, Split};
 use railforce::identify::{SensorTable, Streamer, check, identify};
 use railforce::learn::evaluate::{EvalPart, evaluate};
 use railforce::learn::model::{Model, ModelKind};

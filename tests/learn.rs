@@ -1,6 +1,7 @@
 //! Trainer, model directories and classical regressors on small synthetic problems.
 
-use railforce::features::{DataSet, LabelAt, NoiseProtocol, Run, Split};
+use railforce::dataset::{DataSet, Run};
+use railforce::features::{LabelAt, NoiseProtocol, Split};
 use railforce::learn::classical::{Classical, ClassicalParams};
 use railforce::learn::evaluate::{EvalPart, evaluate};
 use railforce::learn::metrics::metrics;

@@ -317,7 +317,7 @@ fn model_and_data_set_files_parse_or_say_why() {
         .collect();
     let siblings: Vec<&Path> = files.iter().map(|p| p.as_path()).collect();
     fuzz("manifest", &data.join("manifest.json"), &siblings, |p| {
-        railforce::features::DataSet::load(p.parent().unwrap())
+        railforce::dataset::DataSet::load(p.parent().unwrap())
     });
     // Run files, as bytes (NPZ, and Parquet from a second data set): truncated or a bit flipped.
     let pq = dir.join("pq");
@@ -349,7 +349,7 @@ fn model_and_data_set_files_parse_or_say_why() {
                 b[i] ^= 1 << g.random_range(0..8);
             }
             std::fs::write(file, &b).unwrap();
-            let r = std::panic::catch_unwind(|| railforce::features::read_table(file).map(|_| ()));
+            let r = std::panic::catch_unwind(|| railforce::dataset::read_table(file).map(|_| ()));
             match r {
                 Err(_) => panic!("{} case {case}: the reader panicked", file.display()),
                 Ok(Err(e)) => assert!(
@@ -370,8 +370,8 @@ fn model_and_data_set_files_parse_or_say_why() {
 /// CSV truncated inside its last row (issue 34).
 #[test]
 fn run_files_cut_short_are_refused_in_every_format() {
+    use railforce::dataset::read_table;
     use railforce::dataset::{npz, parquet_file};
-    use railforce::features::samples::read_table;
     let dir = std::env::temp_dir().join(format!("railforce-cut-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let n = 50;
@@ -501,18 +501,27 @@ fn one_point_and_misplaced_attachments_are_refused() {
 /// the rms reference they were made with is read.
 #[test]
 fn an_unknown_noise_reference_in_a_manifest_is_refused() {
-    use railforce::features::DataSet;
+    use railforce::dataset::DataSet;
     let dir = std::env::temp_dir().join(format!("railforce-snrref-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("r.csv"), "time_s,a\n0,1\n0.005,2\n").unwrap();
-    let manifest = |reference: &str| {
-        format!(
-            r#"{{"snr_db": 6.0, {reference} "runs": [{{"file": "r.csv", "condition": "c", "seed": 1}}]}}"#
+    // The manifests of today and of the first writer (no reference recorded), their runs
+    // pointed at one small file.
+    let fixture = |name: &str| {
+        std::fs::read_to_string(
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/fixtures/manifests")
+                .join(name),
         )
+        .unwrap()
+        .replace("curve_r400_v60_seed1.npz", "r.csv")
+        .replace("curve_r400_v60_seed4.npz", "r.csv")
     };
+    let today = fixture("2026-12-01.json");
+    assert!(today.contains(r#""snr_reference": "std""#));
     std::fs::write(
         dir.join("manifest.json"),
-        manifest(r#""snr_reference": "bogus","#),
+        today.replace(r#""snr_reference": "std""#, r#""snr_reference": "bogus""#),
     )
     .unwrap();
     let e = DataSet::load(&dir).unwrap_err().to_string();
@@ -520,7 +529,7 @@ fn an_unknown_noise_reference_in_a_manifest_is_refused() {
         e.contains("manifest.json") && e.contains("snr_reference") && e.contains("std or rms"),
         "{e}"
     );
-    std::fs::write(dir.join("manifest.json"), manifest("")).unwrap();
+    std::fs::write(dir.join("manifest.json"), fixture("2026-11-22.json")).unwrap();
     let ds = DataSet::load(&dir).unwrap();
     assert_eq!(
         ds.noise.map(|n| n.reference),

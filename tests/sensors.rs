@@ -3,8 +3,9 @@
 //! static loaded position and show the outer spring nests compressed more in a curve with cant
 //! deficiency; seed splits never share a seed; the shuffled protocol says it leaks.
 
+use railforce::dataset::DataSet;
 use railforce::dataset::{self, Format, GenerateOptions};
-use railforce::features::{DataSet, LabelAt, Samples, Split};
+use railforce::features::{LabelAt, Samples, Split};
 use railforce::plan::Plan;
 use railforce::sensors::{Candidates, ChannelKind, NoiseModel, SnrReference};
 use railforce::sim::output::{self, Recorder};
@@ -99,8 +100,8 @@ fn the_label_wheel_of_the_vehicle_file_reaches_the_labels() {
         settle: 0.1,
     };
     let m = dataset::generate(&plan, &opts, &|_| {}).unwrap();
-    assert_eq!(m["conventions"]["labels"]["FL"], "w2r_force_y");
-    assert_eq!(m["snr_reference"], "std");
+    assert_eq!(m.labels()[0], "w2r_force_y");
+    assert_eq!(m.snr_reference.as_deref(), Some("std"));
     let ds = DataSet::load(&out).unwrap();
     assert_eq!(ds.labels, ["w2r_force_y", "w2r_force_z"]);
     assert_eq!(ds.target_channel("FQ"), "w2r_force_z");
@@ -125,7 +126,7 @@ fn the_label_wheel_of_the_vehicle_file_reaches_the_labels() {
 fn seeded(seeds: &[u64]) -> DataSet {
     let runs = seeds
         .iter()
-        .map(|&s| railforce::features::Run {
+        .map(|&s| railforce::dataset::Run {
             condition: "c".into(),
             seed: s,
             columns: vec![(0..200).map(|i| i as f64).collect()],
@@ -337,7 +338,7 @@ fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
 fn a_signal_recorded_twice_is_one_candidate() {
     let a: Vec<f64> = (0..50).map(|i| (i as f64).sin()).collect();
     let c: Vec<f64> = (0..50).map(|i| (i as f64).cos()).collect();
-    let run = railforce::features::Run {
+    let run = railforce::dataset::Run {
         condition: "c".into(),
         seed: 1,
         columns: vec![a.clone(), a, c],

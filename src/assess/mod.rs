@@ -12,6 +12,7 @@ mod compare;
 pub mod criteria;
 pub mod ride;
 pub mod safety;
+mod section;
 pub mod statistics;
 
 use crate::dsp::{Butterworth, percentile};
@@ -19,9 +20,8 @@ use crate::error::{Error, Result};
 use crate::track::{SectionKind, TrackSpec};
 pub use compare::{StatCheck, compare};
 pub use criteria::Criteria;
-use safety::{Limits, indices};
+use section::Section;
 use serde::Serialize;
-use statistics::sliding_mean;
 
 /// A series of wheel–rail forces in time: the label time and one series per target, in N —
 /// what `identify` writes and the truth of a simulated run alike, so both are judged by the
@@ -210,7 +210,8 @@ fn rate(time: &[f64]) -> f64 {
 }
 
 /// Assesses `run` over `spans` (empty: the whole run as one) against `criteria`, with static
-/// wheel load `q0_kn`.
+/// wheel load `q0_kn`: each section by every criterion in turn (`section`: one function per
+/// criterion).
 pub fn assess(
     run: &RunForces,
     spans: &[Span],
@@ -241,268 +242,19 @@ pub fn assess(
         to_m: f64::INFINITY,
     }];
     let spans = if spans.is_empty() { &whole[..] } else { spans };
-    let c = criteria;
-    let pct = &c.percentiles;
-    let (win, step) = (c.sliding_mean.window_m, c.sliding_mean.step_m);
+    let win = criteria.sliding_mean.window_m;
     let mut rows = Vec::new();
     for span in spans {
-        let idx: Vec<usize> = (0..run.s.len())
-            .filter(|&i| run.s[i] >= span.from_m && run.s[i] < span.to_m)
-            .collect();
-        // A section assessed needs at least one full sliding window.
-        let covered = idx.last().map_or(0.0, |&l| run.s[l] - run.s[idx[0]]);
-        if idx.len() < 2 || covered < win {
+        let Some(sec) = Section::new(run, &wheels, span, criteria, q0_kn, fs) else {
             continue;
-        }
-        let pick = |v: &[f64]| -> Vec<f64> { idx.iter().map(|&i| v[i]).collect() };
-        let s = pick(&run.s);
-        let mut push = |quantity: &str,
-                        place: &str,
-                        value: f64,
-                        limit: f64,
-                        unit: &str,
-                        statistic: String,
-                        criterion: &str| {
-            rows.push(Row {
-                section: span.name.clone(),
-                quantity: quantity.into(),
-                place: place.into(),
-                value,
-                limit,
-                unit: unit.into(),
-                statistic,
-                pass: value <= limit,
-                criterion: criterion.into(),
-            });
         };
-        // Both ends of the sliding means' distribution: the larger in magnitude is assessed.
-        let two_sided = |x: &[f64]| -> f64 {
-            let m: Vec<f64> = sliding_mean(&s, x, win, step)
-                .into_iter()
-                .map(|p| p.1)
-                .collect();
-            percentile(&m, pct.low)
-                .abs()
-                .max(percentile(&m, pct.high).abs())
-        };
-        let sliding_words = format!(
-            "max(|F1|, |F2|) of the {win} m sliding mean every {step} m, F1 = {} %, F2 = {} %",
-            pct.low, pct.high
-        );
-        for w in &wheels {
-            let (y, q) = (pick(&w.y), pick(&w.q));
-            let yq: Vec<f64> = y.iter().zip(&q).map(|(a, b)| a / b.max(1.0)).collect();
-            push(
-                "(Y/Q)2m",
-                &w.wheel,
-                two_sided(&yq),
-                c.y_over_q.limit,
-                "-",
-                sliding_words.clone(),
-                "y_over_q",
-            );
-            push(
-                "Q",
-                &w.wheel,
-                percentile(&q, pct.high) / 1000.0,
-                q0_kn + c.vertical.q_max_over_static_kn,
-                "kN",
-                format!(
-                    "F2 = {} % of the filtered force; limit Q0 + {} kN",
-                    pct.high, c.vertical.q_max_over_static_kn
-                ),
-                "vertical",
-            );
-            if span.radius_m.is_some() {
-                let f0 = pct.quasi_static;
-                push(
-                    "Yqst",
-                    &w.wheel,
-                    percentile(&y, f0).abs() / 1000.0,
-                    c.lateral_quasi_static.y_qst_kn,
-                    "kN",
-                    format!("|F0 = {f0} %| of the filtered force over the curve"),
-                    "lateral_quasi_static",
-                );
-                push(
-                    "Qqst",
-                    &w.wheel,
-                    percentile(&q, f0) / 1000.0,
-                    c.vertical.q_qst_kn,
-                    "kN",
-                    format!("F0 = {f0} % of the filtered force over the curve"),
-                    "vertical",
-                );
-            }
-        }
-        // ΣY = Y_l + Y_r (kN) of every wheelset with both wheels, once for both criteria.
-        let axle_sums: Vec<(usize, Vec<f64>)> = (1..=wheels.len())
-            .filter_map(|axle| {
-                let find = |side: char| wheels.iter().find(|w| w.wheel == format!("w{axle}{side}"));
-                let (l, r) = (find('l')?, find('r')?);
-                let sum = idx.iter().map(|&i| (l.y[i] + r.y[i]) / 1000.0).collect();
-                Some((axle, sum))
-            })
-            .collect();
-        for (axle, sum) in &axle_sums {
-            push(
-                "(ΣY)2m",
-                &format!("wheelset {axle}"),
-                two_sided(sum),
-                c.track_shift.alpha * (10.0 + 2.0 * q0_kn / 3.0),
-                "kN",
-                format!(
-                    "{sliding_words}; limit α·(10 + 2·Q0/3), α = {}",
-                    c.track_shift.alpha
-                ),
-                "track_shift",
-            );
-        }
-        // Running stability: ΣY around its dominant frequency, as a sliding rms over distance.
-        if let Some(st) = &c.stability
-            && covered >= st.window_m
-        {
-            for (axle, sum) in &axle_sums {
-                let Some(f0) = statistics::dominant_frequency(sum, fs, 0.5, c.filter.lowpass_hz)
-                else {
-                    continue;
-                };
-                let band = statistics::band_pass(
-                    sum,
-                    fs,
-                    f0 - st.band_half_width_hz,
-                    f0 + st.band_half_width_hz,
-                    c.filter.order,
-                );
-                let sq: Vec<f64> = band.iter().map(|v| v * v).collect();
-                let rms = sliding_mean(&s, &sq, st.window_m, st.step_m)
-                    .into_iter()
-                    .map(|p| p.1.sqrt())
-                    .fold(0.0f64, f64::max);
-                push(
-                    "(ΣY)rms",
-                    &format!("wheelset {axle}"),
-                    rms,
-                    st.limit_ratio * c.track_shift.alpha * (10.0 + 2.0 * q0_kn / 3.0),
-                    "kN",
-                    format!(
-                        "largest sliding rms over {} m every {} m of ΣY band-passed at f0 = {f0:.2} Hz ± {} Hz; limit {}·(ΣY)lim",
-                        st.window_m, st.step_m, st.band_half_width_hz, st.limit_ratio
-                    ),
-                    "stability",
-                );
-            }
-        }
-        // The Chinese criteria with their time criterion, through the one safety monitor.
-        let id = ForceSeries {
-            targets: wheels
-                .iter()
-                .flat_map(|w| {
-                    [
-                        format!("{}_force_y", w.wheel),
-                        format!("{}_force_z", w.wheel),
-                    ]
-                })
-                .collect(),
-            time: pick(&run.time),
-            values: idx
-                .iter()
-                .map(|&i| wheels.iter().flat_map(|w| [w.y[i], w.q[i]]).collect())
-                .collect(),
-        };
-        let limits = Limits {
-            y_over_q: c.chinese.derailment,
-            unloading: c.chinese.unloading,
-            static_wheel_load_kn: q0_kn,
-            min_duration_s: c.chinese.min_duration_s,
-            lateral_alpha: c.chinese.lateral_alpha,
-        };
-        for r in indices(&id, &limits) {
-            let quantity = match r.index.as_str() {
-                "Y/Q" => "Y/Q (time criterion)".to_string(),
-                "H (kN)" => "H".to_string(),
-                other => other.to_string(),
-            };
-            rows.push(Row {
-                section: span.name.clone(),
-                quantity,
-                place: r.place.clone(),
-                value: r.max,
-                limit: r.limit,
-                unit: if r.index == "H (kN)" { "kN" } else { "-" }.into(),
-                statistic: format!(
-                    "largest filtered value; fails only above the limit for ≥ {:.0} ms ({} exceedance(s), {} shorter)",
-                    c.chinese.min_duration_s * 1000.0,
-                    r.exceedances.len(),
-                    r.brief_excursions
-                ),
-                pass: r.exceedances.is_empty(),
-                criterion: "chinese".into(),
-            });
-        }
-        if let (Some(ca), Some(acc)) = (&c.carbody_acceleration, &run.carbody) {
-            for (k, (name, limit)) in [
-                ("ÿ* lateral (0.4–10 Hz)", ca.lateral_limit),
-                ("z̈* vertical (0.4–10 Hz)", ca.vertical_limit),
-            ]
-            .into_iter()
-            .enumerate()
-            {
-                let band = statistics::band_pass(
-                    &acc[k],
-                    fs,
-                    ca.band_hz[0],
-                    ca.band_hz[1],
-                    c.filter.order,
-                );
-                let band = pick(&band);
-                let v = percentile(&band, pct.low)
-                    .abs()
-                    .max(percentile(&band, pct.high).abs());
-                rows.push(Row {
-                    section: span.name.clone(),
-                    quantity: name.into(),
-                    place: "carbody".into(),
-                    value: v,
-                    limit,
-                    unit: "m/s²".into(),
-                    statistic: format!(
-                        "max(|F1|, |F2|) of the acceleration band-passed {}–{} Hz, F1 = {} %, F2 = {} %",
-                        ca.band_hz[0], ca.band_hz[1], pct.low, pct.high
-                    ),
-                    pass: v <= limit,
-                    criterion: "carbody_acceleration".into(),
-                });
-            }
-        }
-        if let (Some(ride), Some(acc)) = (&c.ride, &run.carbody)
-            && idx.len() as f64 / fs >= ride.min_seconds
-        {
-            for (k, (dir, name)) in [
-                (ride::Direction::Lateral, "Wz lateral"),
-                (ride::Direction::Vertical, "Wz vertical"),
-            ]
-            .into_iter()
-            .enumerate()
-            {
-                let wz =
-                    ride::sperling(&pick(&acc[k]), fs, dir, (ride.band_hz[0], ride.band_hz[1]));
-                rows.push(Row {
-                    section: span.name.clone(),
-                    quantity: name.into(),
-                    place: "carbody".into(),
-                    value: wz,
-                    limit: ride.wz_limit,
-                    unit: "-".into(),
-                    statistic: format!(
-                        "Sperling over the section's spectrum, {}–{} Hz",
-                        ride.band_hz[0], ride.band_hz[1]
-                    ),
-                    pass: wz <= ride.wz_limit,
-                    criterion: "ride".into(),
-                });
-            }
-        }
+        sec.wheel_statistics(&mut rows);
+        let axle_sums = sec.axle_sums();
+        sec.track_shift(&axle_sums, &mut rows);
+        sec.running_stability(&axle_sums, &mut rows);
+        sec.chinese(&mut rows);
+        sec.carbody_acceleration(&mut rows);
+        sec.ride(&mut rows);
     }
     if rows.is_empty() {
         return Err(Error::Domain(format!(

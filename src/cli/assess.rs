@@ -33,7 +33,7 @@ pub struct AssessArgs {
 /// The track a data set's manifest records for the run file `file`, if any.
 fn track_from_manifest(file: &Path) -> Option<PathBuf> {
     let (_, run) = railforce::dataset::run_entry(file)?;
-    let p = PathBuf::from(run["track"]["file"].as_str()?);
+    let p = run.track.file;
     p.exists().then_some(p)
 }
 
@@ -50,7 +50,7 @@ pub fn run(args: AssessArgs) -> Result<()> {
             v.static_wheel_load_kn()
         }
     };
-    let cols = railforce::features::read_table(&args.file)?;
+    let cols = railforce::dataset::read_table(&args.file)?;
     let run = RunForces::from_columns(&args.file.display().to_string(), &cols)?;
     let track = match &args.track {
         Some(t) => Some(super::builtin::resolve(t)?),

@@ -48,8 +48,8 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         let m = dataset::merge(&args.out)?;
         println!(
             "merged {} shard manifests: {} runs in {}",
-            m["merged_from"].as_array().map(|a| a.len()).unwrap_or(0),
-            m["runs"].as_array().map(|a| a.len()).unwrap_or(0),
+            m.merged_from.as_ref().map_or(0, |a| a.len()),
+            m.runs.len(),
             args.out.join("manifest.json").display()
         );
         return Ok(());
@@ -154,7 +154,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     bar.finish_and_clear();
     let manifest = result?;
     let (_, generated, skipped) = *state.lock().expect("lock");
-    let runs = manifest["runs"].as_array().map(|a| a.len()).unwrap_or(0);
+    let runs = manifest.runs.len();
     if generated == 0 && skipped > 0 {
         println!(
             "nothing to do: all {skipped} runs are already in {} with the same settings (delete a run file to redo it)",

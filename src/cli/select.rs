@@ -2,7 +2,8 @@
 
 use anyhow::Result;
 use clap::Args;
-use railforce::features::{self, DataSet, LabelAt, SelectOptions, Split};
+use railforce::dataset::DataSet;
+use railforce::features::{self, LabelAt, SelectOptions, Split};
 use railforce::sensors::Candidates;
 use std::path::PathBuf;
 

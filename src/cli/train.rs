@@ -4,7 +4,8 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use railforce::features::{DataSet, LabelAt, NoiseProtocol, Selection, Split};
+use railforce::dataset::DataSet;
+use railforce::features::{LabelAt, NoiseProtocol, Selection, Split};
 use railforce::learn::evaluate::{EvalPart, evaluate};
 use railforce::learn::model::{Model, ModelKind};
 use railforce::learn::train::{GradientEngine, Progress, TrainOptions, train};

@@ -70,10 +70,10 @@ fn run_meta(run: &Path) -> RunMeta {
     }
     match railforce::dataset::run_entry(run) {
         Some((m, r)) => RunMeta {
-            vehicle: path_of(&m["vehicle"]),
-            track: path_of(&r["track"]),
-            seed: r["seed"].as_u64(),
-            speed_kmh: r["speed_kmh"].as_f64(),
+            vehicle: Some(m.vehicle.file),
+            track: Some(r.track.file),
+            seed: Some(r.seed),
+            speed_kmh: Some(r.speed_kmh),
         },
         None => RunMeta::default(),
     }
@@ -148,7 +148,7 @@ fn build(
             }
         ),
     };
-    let cols = railforce::features::read_table(run)?;
+    let cols = railforce::dataset::read_table(run)?;
     eprintln!(
         "building the view of {} ({} on {}) …",
         run.display(),
@@ -185,7 +185,7 @@ fn write(scene: &Scene, out: &Path) -> Result<()> {
 pub fn run(args: ViewArgs) -> Result<()> {
     let mut identified: Option<(String, Vec<railforce::view::Column>)> = None;
     for p in &args.identified {
-        let id = railforce::features::read_table(p)?;
+        let id = railforce::dataset::read_table(p)?;
         identified = Some(match identified {
             None => (p.display().to_string(), id),
             Some((src, all)) => (
@@ -244,23 +244,18 @@ fn merge(
 /// from the demo report. Returns the page's path.
 pub fn write_demo_view(out: &Path) -> Result<PathBuf> {
     let data = out.join("data");
-    let manifest = read_json(&data.join("manifest.json"))
-        .with_context(|| format!("{}: no manifest.json", data.display()))?;
-    let runs = manifest["runs"].as_array().cloned().unwrap_or_default();
-    let top_seed = runs.iter().filter_map(|r| r["seed"].as_u64()).max();
+    let manifest = railforce::dataset::Manifest::load(&data)?;
+    let runs = &manifest.runs;
+    let top_seed = runs.iter().map(|r| r.seed).max();
     let pick = runs
         .iter()
-        .filter(|r| r["seed"].as_u64() == top_seed)
-        .find(|r| {
-            r["condition"]
-                .as_str()
-                .is_some_and(|c| c.starts_with("curve"))
-        })
-        .or_else(|| runs.iter().find(|r| r["seed"].as_u64() == top_seed))
-        .and_then(|r| r["file"].as_str())
+        .filter(|r| Some(r.seed) == top_seed)
+        .find(|r| r.condition.starts_with("curve"))
+        .or_else(|| runs.iter().find(|r| Some(r.seed) == top_seed))
+        .map(|r| r.file.as_str())
         .context("the demo data set lists no run")?;
     let run = data.join(pick);
-    let cols = railforce::features::read_table(&run)?;
+    let cols = railforce::dataset::read_table(&run)?;
     let mut identified: Vec<railforce::view::Column> = Vec::new();
     let mut names = Vec::new();
     for target in ["fl", "fq"] {

@@ -6,14 +6,16 @@ pub mod geometry;
 pub mod hertz;
 pub mod kalker;
 pub mod profile;
+mod table;
 pub mod validate;
 pub mod wheel_rail;
 
 pub use creep::{CreepContact, CreepForce, CreepLaw, Creepage};
-pub use geometry::{ContactState, ContactTable, Side, WheelContact, WheelsetGeometry};
+pub use geometry::{ContactState, Side, WheelContact, WheelsetGeometry};
 pub use hertz::{HertzEllipse, HertzShape, Material};
 pub use kalker::KalkerCoefficients;
 pub use profile::Profile;
+pub use table::ContactTable;
 pub use wheel_rail::{
     CREEP_SPEED_FLOOR, ContactFrame, ContactModel, PatchForce, WheelForces, WheelOnRail, evaluate,
     height_for_load,

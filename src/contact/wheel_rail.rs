@@ -6,8 +6,9 @@
 //! wheelset in the track frame.
 
 use super::creep::{CreepContact, CreepForce, CreepLaw, Creepage};
-use super::geometry::{ContactTable, Side};
+use super::geometry::Side;
 use super::hertz::{HertzEllipse, Material};
+use super::table::ContactTable;
 
 /// Creepages are slip velocities over the running speed; below this speed (m/s) the speed is
 /// held here: creep forces act as dampers of strength `G·a·b·C/V`, which neither creep theory

@@ -1,12 +1,249 @@
-//! The data set's manifest: content hashes (the data identity), the resume key of each run,
-//! reading and writing `manifest.json`, refusing to mix data sets in one folder, and merging
-//! shard manifests.
+//! The data set's manifest (`manifest.json`), one typed record shared by the writer
+//! (`generate`), the resume check, training, `view` and `assess`: what the runs are, how they
+//! were made (integration step, settling, filter), their noise, conventions and channels.
+//! Also the content hashes (the data identity), the resume key of each run, refusing to mix
+//! data sets in one folder, and merging shard manifests.
+//!
+//! The JSON keeps its keys in alphabetical order at every level (the records pass through
+//! `serde_json::Value`), so a manifest written by this code has the bytes of the untyped
+//! writer before it. Fields that older manifests did not write (`integration`, `dataset`,
+//! `accelerometers`, `labels`, `class`, `start_m`) read as absent; a field that is there but
+//! cannot be read is an error naming the file, the line and the field.
 
 use super::{GenerateOptions, RunSpec};
 use crate::error::{Error, Result};
 use crate::plan::DatasetOptions;
-use serde_json::Value;
+use crate::sensors::{NoiseModel, SnrReference, label_channels};
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// A file the data set was made from, with the FNV-1a hash of its bytes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FileRef {
+    /// Path as the plan resolved it.
+    pub file: PathBuf,
+    /// FNV-1a 64 of the file's bytes, hex.
+    pub hash_fnv1a: String,
+    /// The name inside the file.
+    pub name: String,
+}
+
+/// How the runs were integrated and filtered (written since 2026-12-01).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Integration {
+    /// The integrator, in words.
+    pub integrator: String,
+    /// Integration step, s.
+    pub dt_s: f64,
+    /// Settling time before recording, s (not written).
+    pub settle_s: f64,
+    /// The anti-alias filter before decimation, in words.
+    pub anti_alias: String,
+}
+
+/// The label channels and their wheel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Labels {
+    /// Lateral force channel (FL).
+    #[serde(rename = "FL")]
+    pub fl: String,
+    /// Vertical force channel (FQ).
+    #[serde(rename = "FQ")]
+    pub fq: String,
+    /// The label wheel (`1L` … `4R`; absent in manifests before it was a setting).
+    #[serde(default)]
+    pub wheel: Option<String>,
+}
+
+/// Frames, signs and what the sensors read, in words and names.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Conventions {
+    /// The track frame.
+    pub frame: String,
+    /// Force signs and names.
+    pub forces: String,
+    /// Wheel numbering.
+    pub wheels: String,
+    /// What the accelerations are, in words.
+    pub accelerations: String,
+    /// `specific-force` or `kinematic` (absent in manifests before it was recorded).
+    #[serde(default)]
+    pub accelerometers: Option<String>,
+    /// The label channels (absent in manifests before the label wheel was a setting: 1L).
+    #[serde(default)]
+    pub labels: Option<Labels>,
+}
+
+/// One channel of the run files.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChannelEntry {
+    /// Column name.
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Kind (`input`, `input_noisy`, `label`, `wheel`, `body`, `deflection`, `axis`).
+    pub kind: String,
+    /// The wheel of a wheel or label channel (`1L` …).
+    pub wheel: Option<String>,
+}
+
+/// One run of the data set.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunEntry {
+    /// Resume key: the hash of everything that shapes the run's data.
+    pub key: String,
+    /// Condition name.
+    pub condition: String,
+    /// Irregularity seed.
+    pub seed: u64,
+    /// Run file, relative to the data set's folder.
+    pub file: String,
+    /// FNV-1a 64 of the run file's bytes.
+    pub bytes_hash_fnv1a: String,
+    /// The track file.
+    pub track: FileRef,
+    /// Running speed, km/h.
+    pub speed_kmh: f64,
+    /// Recorded duration, s.
+    pub duration_s: f64,
+    /// Vehicle name (absent in manifests before conditions had their own vehicle).
+    #[serde(default)]
+    pub vehicle: Option<String>,
+    /// FRA class the plan set instead of the track file's.
+    #[serde(default)]
+    pub class: Option<i64>,
+    /// Start position along the track, m.
+    #[serde(default)]
+    pub start_m: Option<f64>,
+    /// Rows written.
+    pub rows: usize,
+    /// Wall time of the run, s.
+    pub wall_time_s: f64,
+    /// Largest |Y/Q| of each wheel, 1L … 4R.
+    pub peak_y_over_q: Vec<f64>,
+}
+
+/// The manifest of a data set.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// `railforce <version>` that wrote it.
+    pub tool: String,
+    /// The plan file.
+    pub plan: PathBuf,
+    /// The plan's name.
+    pub plan_name: String,
+    /// The plan's vehicle.
+    pub vehicle: FileRef,
+    /// Run file format: `npz`, `parquet` or `csv`.
+    pub format: String,
+    /// Output sampling rate, Hz.
+    pub sampling_rate_hz: f64,
+    /// How the runs were made (absent before 2026-12-01).
+    #[serde(default)]
+    pub integration: Option<Integration>,
+    /// The plan's `[dataset]` options (absent in older manifests: the defaults).
+    #[serde(default)]
+    pub dataset: DatasetOptions,
+    /// SNR of the `_noisy` copies, dB (`null`: clean).
+    #[serde(default)]
+    pub snr_db: Option<f64>,
+    /// `std` or `rms` (`null` with an SNR: written before it was recorded, the rms).
+    #[serde(default)]
+    pub snr_reference: Option<String>,
+    /// The noise, in words.
+    #[serde(default)]
+    pub noise: Option<String>,
+    /// `i/N` for a shard manifest.
+    #[serde(default)]
+    pub shard: Option<String>,
+    /// The shard manifests a merge joined.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub merged_from: Option<Vec<String>>,
+    /// Conventions.
+    pub conventions: Conventions,
+    /// The run files' channels (`null` until the first run finished).
+    #[serde(default)]
+    pub channels: Option<Vec<ChannelEntry>>,
+    /// The runs, sorted by condition and seed.
+    pub runs: Vec<RunEntry>,
+}
+
+impl Manifest {
+    /// Reads a manifest; `Ok(None)` when the file does not exist.
+    pub fn read(path: &Path) -> Result<Option<Self>> {
+        if !path.exists() {
+            return Ok(None);
+        }
+        let text = crate::io::read_text(path)?;
+        serde_json::from_str(&text).map(Some).map_err(|e| {
+            // serde names the line; the key on that line names the field.
+            let key = text
+                .lines()
+                .nth(e.line().saturating_sub(1))
+                .and_then(|l| l.trim().strip_prefix('"'))
+                .and_then(|l| l.split('"').next())
+                .map(|k| format!(" (field \"{k}\")"))
+                .unwrap_or_default();
+            Error::Parse {
+                file: path.to_path_buf(),
+                message: format!("not a railforce manifest{key}: {e}"),
+            }
+        })
+    }
+
+    /// Reads `manifest.json` in a data set's folder; a missing file is an error.
+    pub fn load(dir: &Path) -> Result<Self> {
+        let path = dir.join("manifest.json");
+        Self::read(&path)?.ok_or_else(|| Error::io(&path, std::io::ErrorKind::NotFound.into()))
+    }
+
+    /// Writes the manifest atomically, keys in alphabetical order, pretty-printed.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let value = serde_json::to_value(self).map_err(|e| Error::Domain(e.to_string()))?;
+        crate::io::write_atomic(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &value).map_err(std::io::Error::other)?;
+            w.write_all(b"\n")
+        })
+    }
+
+    /// The noise of the `_noisy` copies (`None`: clean). An unknown reference is an error
+    /// naming `path` and the field; none with an SNR is the rms of manifests before it was
+    /// recorded.
+    pub fn noise_model(&self, path: &Path) -> Result<Option<NoiseModel>> {
+        let Some(snr) = self.snr_db else {
+            return Ok(None);
+        };
+        let reference = match self.snr_reference.as_deref() {
+            None => SnrReference::Rms,
+            Some(r) => SnrReference::parse(r).ok_or_else(|| {
+                Error::config(
+                    path,
+                    "snr_reference",
+                    format!("\"{r}\" is not a noise reference: std or rms"),
+                )
+            })?,
+        };
+        Ok(Some(NoiseModel::new(snr, reference)))
+    }
+
+    /// The label channels FL and FQ (wheel 1L's where the manifest names none).
+    pub fn labels(&self) -> [String; 2] {
+        match &self.conventions.labels {
+            Some(l) => [l.fl.clone(), l.fq.clone()],
+            None => label_channels("1L"),
+        }
+    }
+
+    /// The entry of the run file named `name`.
+    pub fn run(&self, name: &str) -> Option<&RunEntry> {
+        self.runs.iter().find(|r| r.file == name)
+    }
+
+    pub(super) fn sort_runs(&mut self) {
+        self.runs
+            .sort_by(|a, b| (&a.condition, a.seed).cmp(&(&b.condition, b.seed)));
+    }
+}
 
 /// FNV-1a 64 of bytes, hex.
 pub fn fnv1a(bytes: &[u8]) -> String {
@@ -23,26 +260,14 @@ pub fn fnv1a(bytes: &[u8]) -> String {
 /// order runs finished in are left out, so a rerun that changes no data keeps the identity
 /// and any changed byte of any run changes it.
 pub fn data_identity(dir: &Path) -> Result<String> {
-    let path = dir.join("manifest.json");
-    let m = read_manifest(&path)?
-        .ok_or_else(|| Error::io(&path, std::io::ErrorKind::NotFound.into()))?;
-    let mut runs: Vec<(String, String)> = m["runs"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .map(|r| {
-                    (
-                        r["file"].as_str().unwrap_or_default().to_string(),
-                        r["bytes_hash_fnv1a"]
-                            .as_str()
-                            .unwrap_or_default()
-                            .to_string(),
-                    )
-                })
-                .collect()
-        })
-        .unwrap_or_default();
+    let m = Manifest::load(dir)?;
+    let mut runs: Vec<(&str, &str)> = m
+        .runs
+        .iter()
+        .map(|r| (r.file.as_str(), r.bytes_hash_fnv1a.as_str()))
+        .collect();
     if runs.is_empty() {
+        let path = dir.join("manifest.json");
         return Err(Error::config(&path, "runs", "the manifest lists no runs"));
     }
     runs.sort();
@@ -100,40 +325,11 @@ pub fn manifest_path(opts: &GenerateOptions) -> PathBuf {
     }
 }
 
-pub(super) fn write_manifest(path: &Path, manifest: &Value) -> Result<()> {
-    crate::io::write_atomic(path, |w| {
-        serde_json::to_writer_pretty(&mut *w, manifest).map_err(std::io::Error::other)?;
-        w.write_all(b"\n")
-    })
-}
-
-pub(super) fn read_manifest(path: &Path) -> Result<Option<Value>> {
-    if !path.exists() {
-        return Ok(None);
-    }
-    let text = crate::io::read_text(path)?;
-    serde_json::from_str(&text)
-        .map(Some)
-        .map_err(|e| Error::Parse {
-            file: path.to_path_buf(),
-            message: e.to_string(),
-        })
-}
-
-pub(super) fn sort_runs(m: &mut Value) {
-    if let Some(runs) = m["runs"].as_array_mut() {
-        runs.sort_by(|a, b| {
-            (a["condition"].as_str(), a["seed"].as_u64())
-                .cmp(&(b["condition"].as_str(), b["seed"].as_u64()))
-        });
-    }
-}
-
 /// Refuses to add runs to a folder whose data set was written in another format, at another
 /// SNR or with other data-set options: one folder, one data set.
 pub(super) fn refuse_mixing(
     manifest: &Path,
-    previous: Option<&Value>,
+    previous: Option<&Manifest>,
     opts: &GenerateOptions,
     dataset: &DatasetOptions,
 ) -> Result<()> {
@@ -141,8 +337,8 @@ pub(super) fn refuse_mixing(
         return Ok(());
     };
     let snr = |v: Option<f64>| v.map_or("clean".to_string(), |s| format!("{s} dB"));
-    let (had_format, had_snr) = (m["format"].as_str().unwrap_or("?"), m["snr_db"].as_f64());
-    let had_ref = m["snr_reference"].as_str();
+    let (had_format, had_snr) = (m.format.as_str(), m.snr_db);
+    let had_ref = m.snr_reference.as_deref();
     let now_ref = opts.noise.map(|n| n.reference.name());
     let mut differ = Vec::new();
     if had_format != opts.format.ext() {
@@ -161,10 +357,13 @@ pub(super) fn refuse_mixing(
                 .unwrap_or_default(),
         ));
     }
-    let had_ds = &m["dataset"];
-    let now_ds = serde_json::to_value(dataset).expect("options serialise");
-    if !(had_ds == &now_ds || (had_ds.is_null() && *dataset == DatasetOptions::default())) {
-        differ.push(format!("data-set options {had_ds} (now {now_ds})"));
+    if m.dataset != *dataset {
+        let json = |d: &DatasetOptions| serde_json::to_string(d).unwrap_or_default();
+        differ.push(format!(
+            "data-set options {} (now {})",
+            json(&m.dataset),
+            json(dataset)
+        ));
     }
     if differ.is_empty() {
         return Ok(());
@@ -178,21 +377,15 @@ pub(super) fn refuse_mixing(
 
 /// The manifest of the data set a run file belongs to (`manifest.json` beside it) and the
 /// run's entry in it, when the file is listed there.
-pub fn run_entry(run_file: &Path) -> Option<(Value, Value)> {
+pub fn run_entry(run_file: &Path) -> Option<(Manifest, RunEntry)> {
     let dir = run_file.parent().unwrap_or(Path::new("."));
-    let text = std::fs::read_to_string(dir.join("manifest.json")).ok()?;
-    let m: Value = serde_json::from_str(&text).ok()?;
-    let name = run_file.file_name()?.to_str()?;
-    let entry = m["runs"]
-        .as_array()?
-        .iter()
-        .find(|r| r["file"] == name)?
-        .clone();
+    let m = Manifest::read(&dir.join("manifest.json")).ok()??;
+    let entry = m.run(run_file.file_name()?.to_str()?)?.clone();
     Some((m, entry))
 }
 
 /// Joins the shard manifests in `out` into `manifest.json` (runs sorted by condition and seed).
-pub fn merge(out: &Path) -> Result<Value> {
+pub fn merge(out: &Path) -> Result<Manifest> {
     let mut shards: Vec<PathBuf> = std::fs::read_dir(out)
         .map_err(|e| Error::io(out, e))?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -203,56 +396,52 @@ pub fn merge(out: &Path) -> Result<Value> {
         })
         .collect();
     shards.sort();
-    if shards.is_empty() {
-        return Err(Error::Domain(format!(
-            "no manifest.shard-*.json in {}",
-            out.display()
-        )));
-    }
-    let mut merged: Option<Value> = None;
+    let mut merged: Option<Manifest> = None;
     for path in &shards {
-        let m = read_manifest(path)?
+        let m = Manifest::read(path)?
             .ok_or_else(|| Error::Domain(format!("{} disappeared", path.display())))?;
-        if !m.is_object() || !m["runs"].is_array() {
-            return Err(Error::config(
-                path,
-                "runs",
-                "missing or not a list: not a railforce shard manifest",
-            ));
-        }
         match merged.as_mut() {
             None => merged = Some(m),
             Some(all) => {
-                for key in ["vehicle", "format", "snr_db", "snr_reference", "plan"] {
-                    if all[key] != m[key] {
-                        return Err(Error::Domain(format!(
-                            "{} disagrees with the other shards on '{key}'",
-                            path.display()
-                        )));
-                    }
+                let differs = [
+                    ("vehicle", all.vehicle != m.vehicle),
+                    ("format", all.format != m.format),
+                    ("snr_db", all.snr_db != m.snr_db),
+                    ("snr_reference", all.snr_reference != m.snr_reference),
+                    ("plan", all.plan != m.plan),
+                ];
+                if let Some((key, _)) = differs.iter().find(|(_, d)| *d) {
+                    return Err(Error::Domain(format!(
+                        "{} disagrees with the other shards on '{key}'",
+                        path.display()
+                    )));
                 }
-                if all["channels"].is_null() {
-                    all["channels"] = m["channels"].clone();
+                if all.channels.is_none() {
+                    all.channels = m.channels;
                 }
-                let runs = m["runs"].as_array().cloned().unwrap_or_default();
-                if let Some(all_runs) = all["runs"].as_array_mut() {
-                    all_runs.extend(runs);
-                }
+                all.runs.extend(m.runs);
             }
         }
     }
     let Some(mut m) = merged else {
         return Err(Error::Domain(format!(
-            "no shard manifest in {}",
+            "no manifest.shard-*.json in {}",
             out.display()
         )));
     };
-    m["shard"] = Value::Null;
-    m["merged_from"] = shards
-        .iter()
-        .map(|p| Value::from(p.file_name().unwrap().to_string_lossy().into_owned()))
-        .collect();
-    sort_runs(&mut m);
-    write_manifest(&out.join("manifest.json"), &m)?;
+    m.shard = None;
+    m.merged_from = Some(
+        shards
+            .iter()
+            .map(|p| {
+                p.file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect(),
+    );
+    m.sort_runs();
+    m.write(&out.join("manifest.json"))?;
     Ok(m)
 }

@@ -4,12 +4,19 @@
 //! finished run, and a rerun skips the runs the manifest lists as done with an unchanged
 //! definition. `--shard i/N` splits a plan across machines; `merge` joins shard manifests.
 
+mod data_set;
 mod manifest;
 pub mod npz;
 pub mod parquet_file;
+mod table;
 
-pub use manifest::{data_identity, file_hash, fnv1a, manifest_path, merge, run_entry};
-use manifest::{read_manifest, refuse_mixing, run_key, sort_runs, write_manifest};
+pub use data_set::{DataSet, Run};
+pub use manifest::{
+    ChannelEntry, Conventions, FileRef, Integration, Labels, Manifest, RunEntry, data_identity,
+    file_hash, fnv1a, manifest_path, merge, run_entry,
+};
+use manifest::{refuse_mixing, run_key};
+pub use table::{read_csv, read_table};
 
 use crate::error::{Error, Result};
 use crate::plan::{Condition, Plan};
@@ -18,7 +25,6 @@ use crate::sim::output::{self, Recording};
 use crate::sim::{SimConfig, Simulation};
 use crate::track::{Track, TrackSpec};
 use crate::vehicle::Vehicle;
-use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -153,7 +159,7 @@ pub fn generate(
     plan: &Plan,
     opts: &GenerateOptions,
     events: &(dyn Fn(Event) + Sync),
-) -> Result<Value> {
+) -> Result<Manifest> {
     if let Some((i, n)) = opts.shard
         && !(n >= 1 && (1..=n).contains(&i))
     {
@@ -185,7 +191,7 @@ pub fn generate(
         ));
     }
     let manifest_file = manifest_path(opts);
-    let previous = read_manifest(&manifest_file)?;
+    let previous = Manifest::read(&manifest_file)?;
     refuse_mixing(&manifest_file, previous.as_ref(), opts, dataset)?;
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
     let vehicle = Vehicle::load(&plan.vehicle)?;
@@ -242,46 +248,53 @@ pub fn generate(
         }
         tracks.push((spec, file_hash(&r.condition.track)?));
     }
-    let done: Vec<Value> = previous
-        .as_ref()
-        .and_then(|m| m.get("runs").and_then(|r| r.as_array()).cloned())
-        .unwrap_or_default();
+    let done: &[RunEntry] = previous.as_ref().map_or(&[], |m| &m.runs);
     for (_, v, _) in &vehicles {
         v.contact.table(); // build once, before the threads
     }
-    let manifest = Mutex::new(json!({
-        "tool": format!("railforce {}", env!("CARGO_PKG_VERSION")),
-        "plan": plan.source,
-        "plan_name": plan.name,
-        "vehicle": {"file": plan.vehicle, "hash_fnv1a": file_hash(&plan.vehicle)?, "name": vehicle.name},
-        "format": opts.format.ext(),
-        "sampling_rate_hz": SimConfig::default().output_rate,
-        // How the runs were made, so a data set says how to regenerate it (issue 34).
-        "integration": {
-            "integrator": "semi-implicit Euler, fixed step (src/sim/mod.rs)",
-            "dt_s": SimConfig::default().dt,
-            "settle_s": opts.settle,
-            "anti_alias": format!(
-                "8th-order Butterworth low-pass at {} Hz at the integration rate, then decimated",
-                SimConfig::default().cutoff
-            ),
+    let integration = Integration {
+        integrator: "semi-implicit Euler, fixed step (src/sim/mod.rs)".into(),
+        dt_s: SimConfig::default().dt,
+        settle_s: opts.settle,
+        anti_alias: format!(
+            "8th-order Butterworth low-pass at {} Hz at the integration rate, then decimated",
+            SimConfig::default().cutoff
+        ),
+    };
+    let manifest = Mutex::new(Manifest {
+        tool: format!("railforce {}", env!("CARGO_PKG_VERSION")),
+        plan: plan.source.clone(),
+        plan_name: plan.name.clone(),
+        vehicle: FileRef {
+            file: plan.vehicle.clone(),
+            hash_fnv1a: file_hash(&plan.vehicle)?,
+            name: vehicle.name.clone(),
         },
-        "dataset": dataset,
-        "snr_db": opts.noise.map(|n| n.snr_db),
-        "snr_reference": opts.noise.map(|n| n.reference.name()),
-        "noise": opts.noise.map(|n| format!("{}; the paper's input channels only (suffix _noisy), clean channels always kept", n.describe())),
-        "shard": opts.shard.map(|(i, n)| format!("{i}/{n}")),
-        "conventions": {
-            "frame": "track frame: x along the running direction, y to the left, z up",
-            "forces": "forces of the rail on the wheel in the track frame: force_y = Y (+ left), force_z = Q (+ up) (EN: Y lateral, Q vertical; Chinese standards: Q lateral, P vertical)",
-            "wheels": "1L..4R numbered from the front, left/right facing the running direction",
-            "accelerations": vehicle.accelerometers.describe(),
-            "accelerometers": vehicle.accelerometers.name(),
-            "labels": {"FL": labels[0], "FQ": labels[1], "wheel": vehicle.label_wheel_name()},
+        format: opts.format.ext().into(),
+        sampling_rate_hz: SimConfig::default().output_rate,
+        // How the runs were made, so a data set says how to regenerate it.
+        integration: Some(integration),
+        dataset: dataset.clone(),
+        snr_db: opts.noise.map(|n| n.snr_db),
+        snr_reference: opts.noise.map(|n| n.reference.name().into()),
+        noise: opts.noise.map(|n| format!("{}; the paper's input channels only (suffix _noisy), clean channels always kept", n.describe())),
+        shard: opts.shard.map(|(i, n)| format!("{i}/{n}")),
+        merged_from: None,
+        conventions: Conventions {
+            frame: "track frame: x along the running direction, y to the left, z up".into(),
+            forces: "forces of the rail on the wheel in the track frame: force_y = Y (+ left), force_z = Q (+ up) (EN: Y lateral, Q vertical; Chinese standards: Q lateral, P vertical)".into(),
+            wheels: "1L..4R numbered from the front, left/right facing the running direction".into(),
+            accelerations: vehicle.accelerometers.describe().into(),
+            accelerometers: Some(vehicle.accelerometers.name().into()),
+            labels: Some(Labels {
+                fl: labels[0].clone(),
+                fq: labels[1].clone(),
+                wheel: Some(vehicle.label_wheel_name()),
+            }),
         },
-        "channels": Value::Null,
-        "runs": [],
-    }));
+        channels: None,
+        runs: Vec::new(),
+    });
     let next = AtomicUsize::new(0);
     let first_error: Mutex<Option<Error>> = Mutex::new(None);
     let work = |k: usize| -> Result<()> {
@@ -294,18 +307,15 @@ pub fn generate(
         let key = run_key(run, opts, track_hash, vehicle_hash, dataset);
         let file = run.file_name(opts.format);
         let path = opts.out.join(&file);
-        if let Some(entry) = done.iter().find(|e| e["key"] == key.as_str())
+        if let Some(entry) = done.iter().find(|e| e.key == key)
             && path.exists()
         {
             events(Event::Skipped(file.clone()));
             let mut m = manifest.lock().expect("manifest lock");
-            if m["channels"].is_null() {
-                m["channels"] = previous
-                    .as_ref()
-                    .map(|p| p["channels"].clone())
-                    .unwrap_or(Value::Null);
+            if m.channels.is_none() {
+                m.channels = previous.as_ref().and_then(|p| p.channels.clone());
             }
-            m["runs"].as_array_mut().expect("runs").push(entry.clone());
+            m.runs.push(entry.clone());
             return Ok(());
         }
         events(Event::Started(file.clone()));
@@ -329,28 +339,29 @@ pub fn generate(
             .map_err(|m| Error::config(&plan.source, "dataset.channels", m))?;
         write_run(&path, &rec, opts.format, dataset.float32)?;
         let bytes_hash = file_hash(&path)?;
-        let entry = json!({
-            "key": key,
-            "condition": run.condition.name,
-            "seed": run.seed,
-            "file": file,
-            "bytes_hash_fnv1a": bytes_hash,
-            "track": {"file": run.condition.track, "hash_fnv1a": track_hash, "name": spec.name},
-            "speed_kmh": run.condition.speed_kmh,
-            "duration_s": run.condition.duration,
-            "vehicle": vehicle.name,
-            "class": run.condition.class,
-            "start_m": run.condition.start_m,
-            "rows": rec.rows.len(),
-            "wall_time_s": rec.summary.wall,
-            "peak_y_over_q": rec.summary.peak_y_over_q,
-        });
+        let entry = RunEntry {
+            key,
+            condition: run.condition.name.clone(),
+            seed: run.seed,
+            file: file.clone(),
+            bytes_hash_fnv1a: bytes_hash,
+            track: FileRef {
+                file: run.condition.track.clone(),
+                hash_fnv1a: track_hash.clone(),
+                name: spec.name.clone(),
+            },
+            speed_kmh: run.condition.speed_kmh,
+            duration_s: run.condition.duration,
+            vehicle: Some(vehicle.name.clone()),
+            class: run.condition.class,
+            start_m: run.condition.start_m,
+            rows: rec.rows.len(),
+            wall_time_s: rec.summary.wall,
+            peak_y_over_q: rec.summary.peak_y_over_q,
+        };
         let mut m = manifest.lock().expect("manifest lock");
-        if !m["channels"].is_null() {
-            let names: Vec<&str> = m["channels"]
-                .as_array()
-                .map(|a| a.iter().filter_map(|c| c["name"].as_str()).collect())
-                .unwrap_or_default();
+        if let Some(channels) = &m.channels {
+            let names: Vec<&str> = channels.iter().map(|c| c.name.as_str()).collect();
             if names != rec.names.iter().map(|n| n.as_str()).collect::<Vec<_>>() {
                 return Err(Error::Domain(format!(
                     "{} (vehicle {}) records other channels than the data set's first run: one data set has one set of channels",
@@ -358,22 +369,28 @@ pub fn generate(
                 )));
             }
         }
-        if m["channels"].is_null() {
-            m["channels"] = rec
-                .names
-                .iter()
-                .zip(&rec.units)
-                .map(|(n, u)| {
-                    let kind = ChannelKind::of(n, &labels);
-                    let wheel = (kind == ChannelKind::Label || kind == ChannelKind::Wheel)
-                        .then(|| n[1..3].to_ascii_uppercase());
-                    json!({"name": n, "unit": u, "kind": kind.name(), "wheel": wheel})
-                })
-                .collect();
+        if m.channels.is_none() {
+            m.channels = Some(
+                rec.names
+                    .iter()
+                    .zip(&rec.units)
+                    .map(|(n, u)| {
+                        let kind = ChannelKind::of(n, &labels);
+                        let wheel = (kind == ChannelKind::Label || kind == ChannelKind::Wheel)
+                            .then(|| n[1..3].to_ascii_uppercase());
+                        ChannelEntry {
+                            name: n.clone(),
+                            unit: u.to_string(),
+                            kind: kind.name().into(),
+                            wheel,
+                        }
+                    })
+                    .collect(),
+            );
         }
-        m["runs"].as_array_mut().expect("runs").push(entry);
-        sort_runs(&mut m);
-        write_manifest(&manifest_file, &m)?;
+        m.runs.push(entry);
+        m.sort_runs();
+        m.write(&manifest_file)?;
         events(Event::Finished(file, rec.summary.wall));
         Ok(())
     };
@@ -397,8 +414,8 @@ pub fn generate(
         }
     });
     let mut m = manifest.into_inner().expect("manifest lock");
-    sort_runs(&mut m);
-    write_manifest(&manifest_file, &m)?;
+    m.sort_runs();
+    m.write(&manifest_file)?;
     if let Some(e) = first_error.into_inner().expect("error lock") {
         return Err(e);
     }

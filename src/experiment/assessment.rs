@@ -3,8 +3,8 @@
 
 use super::f4;
 use crate::assess::{Criteria, RunForces, StatCheck, assess, compare, spans};
+use crate::dataset::DataSet;
 use crate::error::Result;
-use crate::features::DataSet;
 use crate::identify::Identified;
 use crate::learn::evaluate::PredictionRow;
 use crate::plan::Plan;

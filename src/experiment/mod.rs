@@ -15,9 +15,10 @@ mod protocols;
 mod robustness;
 mod sensors;
 
+use crate::dataset::DataSet;
 use crate::dataset::{Format, GenerateOptions, generate};
 use crate::error::{Error, Result};
-use crate::features::{DataSet, LabelAt, NoiseProtocol, Split};
+use crate::features::{LabelAt, NoiseProtocol, Split};
 use crate::learn::metrics::{Metrics, metrics};
 use crate::learn::model::{Model, ModelKind};
 use crate::learn::train::{EpochLog, Progress, TrainOptions, train};

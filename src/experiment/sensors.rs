@@ -93,7 +93,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 .transpose()
         })
         .collect::<Result<Vec<_>>>()?;
-    let sets: Vec<&crate::features::DataSet> =
+    let sets: Vec<&crate::dataset::DataSet> =
         others.iter().map(|o| o.as_ref().unwrap_or(&dsn)).collect();
     let cases: Vec<(f64, &str, &Vec<String>, usize)> = opts
         .sensor_snrs

@@ -6,11 +6,9 @@ pub mod samples;
 pub mod split;
 pub mod wrapper;
 
-pub use samples::{
-    Block, DataSet, LabelAt, NoiseProtocol, Part, Run, Samples, Split, Window, ZScore, read_csv,
-    read_table,
-};
+pub use samples::{Block, LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
 
+use crate::dataset::DataSet;
 use crate::error::{Error, Result};
 use crate::sensors::{Candidates, noisy_name};
 use serde::{Deserialize, Serialize};

@@ -2,7 +2,7 @@
 //! (assets/docs/learning.md §1.1): by seed (the default), in contiguous blocks, by condition, or
 //! shuffled (leaky, labelled so).
 
-use super::samples::DataSet;
+use crate::dataset::DataSet;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 

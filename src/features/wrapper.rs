@@ -3,7 +3,8 @@
 //! the training and validation windows are built once; each candidate subset is then a
 //! Cholesky solve on a sub-block, so the search costs milliseconds.
 
-use super::samples::{DataSet, Samples, Window, ZScore};
+use super::samples::{Samples, Window, ZScore};
+use crate::dataset::DataSet;
 
 /// Lags (offsets from the last step backwards) used by the fast model: every 2nd step of the
 /// window (half the features at a quarter of the cost). A stand-in for the network, not the

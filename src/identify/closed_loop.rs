@@ -4,9 +4,10 @@
 
 use super::safety::{Limits, indices};
 use super::{Identified, SensorTable, check, identify};
+use crate::dataset::DataSet;
 use crate::dataset::{Format, GenerateOptions, generate};
 use crate::error::{Error, Result};
-use crate::features::{DataSet, NoiseProtocol};
+use crate::features::NoiseProtocol;
 use crate::learn::model::Model;
 use crate::learn::windows::label_offset;
 use crate::plan::Plan;

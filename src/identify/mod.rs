@@ -36,7 +36,7 @@ pub struct SensorTable {
 impl SensorTable {
     /// Reads a CSV, NPZ or Parquet file with a time column.
     pub fn read(path: &Path) -> Result<Self> {
-        let cols = crate::features::read_table(path)?;
+        let cols = crate::dataset::read_table(path)?;
         Self::from_columns(path.display().to_string(), cols)
     }
 

@@ -4,8 +4,9 @@
 use super::metrics::{Metrics, metrics};
 use super::model::Model;
 use super::windows::prepare;
+use crate::dataset::DataSet;
 use crate::error::Result;
-use crate::features::{DataSet, Split, ZScore};
+use crate::features::{Split, ZScore};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;

@@ -2,7 +2,7 @@
 //! (`--features burn`). The trainer and `bench learn` run the same [`Stepper`].
 
 use super::neural::{NetConfig, Network};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// What computes a network's forward and backward pass in training. The weights, Adam, the
@@ -69,14 +69,14 @@ impl Stepper {
             GradientEngine::Fused => Ok(Stepper::Fused),
             #[cfg(feature = "burn")]
             burn => {
-                let device = super::burn::device(burn)?;
+                let device = burn_device(burn)?;
                 let net = super::burn::BurnNet::new(config, &device);
                 Ok(Stepper::Burn(Box::new(net), device))
             }
             #[cfg(not(feature = "burn"))]
             other => {
                 let _ = config;
-                Err(crate::error::Error::Domain(format!(
+                Err(Error::Domain(format!(
                     "--engine {} needs burn, and this railforce was built without it: rebuild with `cargo build --release --features {}`",
                     other.name(),
                     if other == GradientEngine::BurnGpu {
@@ -117,5 +117,24 @@ impl Stepper {
             #[cfg(feature = "burn")]
             Stepper::Burn(module, device) => module.gradients(net, x, y, n, device),
         }
+    }
+}
+
+/// The burn device (without autodiff) of a gradient engine: burn-flex on the CPU, or the best
+/// GPU wgpu finds through Vulkan (an error when this build lacks the backend, or for the fused
+/// engine).
+#[cfg(feature = "burn")]
+pub fn burn_device(engine: GradientEngine) -> Result<::burn::tensor::Device> {
+    match engine {
+        GradientEngine::BurnCpu => Ok(::burn::tensor::Device::flex()),
+        #[cfg(feature = "burn-gpu")]
+        GradientEngine::BurnGpu => super::burn::gpu(),
+        #[cfg(not(feature = "burn-gpu"))]
+        GradientEngine::BurnGpu => Err(Error::Domain(
+            "this railforce was built without burn's GPU backend: rebuild with `cargo build --release --features burn-gpu`".into(),
+        )),
+        GradientEngine::Fused => Err(Error::Domain(
+            "the fused engine is not a burn device".into(),
+        )),
     }
 }

@@ -3,8 +3,9 @@
 //! targets. Built per part from the leak-free [`Samples`] with the statistics of the training
 //! blocks only (assets/docs/learning.md §1).
 
+use crate::dataset::DataSet;
 use crate::error::{Error, Result};
-use crate::features::{DataSet, LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
+use crate::features::{LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
 use crate::sensors::NoiseModel;
 use crate::sensors::noise::rng;
 use serde::{Deserialize, Serialize};
@@ -286,7 +287,7 @@ impl NoiseRefresher {
 }
 
 /// A run's columns standardised and interleaved row-major.
-fn interleave(run: &crate::features::Run, cols: &[usize], z: &ZScore) -> Vec<f32> {
+fn interleave(run: &crate::dataset::Run, cols: &[usize], z: &ZScore) -> Vec<f32> {
     let n = run.len();
     let mut out = vec![0.0f32; n * cols.len()];
     for (k, &c) in cols.iter().enumerate() {

@@ -15,7 +15,6 @@
 
 mod bridge;
 
-use super::gradient::GradientEngine;
 use super::linalg::LEAKY_SLOPE;
 use super::neural::batch_norm::{EPS, MOMENTUM};
 use super::neural::network::{HEAD, HIDDEN, STEM_WIDTH};
@@ -28,29 +27,11 @@ use ::burn::nn::{
 use ::burn::tensor::activation::leaky_relu;
 use ::burn::tensor::{Device, Tensor, TensorData};
 
-/// The burn device (without autodiff) of a gradient engine: burn-flex on the CPU, or the best
-/// GPU wgpu finds through Vulkan (an error when this build lacks the backend, or for the fused
-/// engine).
-pub fn device(engine: GradientEngine) -> Result<Device> {
-    match engine {
-        GradientEngine::BurnCpu => Ok(Device::flex()),
-        #[cfg(feature = "burn-gpu")]
-        GradientEngine::BurnGpu => gpu(),
-        #[cfg(not(feature = "burn-gpu"))]
-        GradientEngine::BurnGpu => Err(Error::Domain(
-            "this railforce was built without burn's GPU backend: rebuild with `cargo build --release --features burn-gpu`".into(),
-        )),
-        GradientEngine::Fused => Err(Error::Domain(
-            "the fused engine is not a burn device".into(),
-        )),
-    }
-}
-
 /// The best GPU wgpu finds through Vulkan, probed with one small tensor: burn's runtime
 /// panics (in its own thread) when there is no adapter, which becomes an error naming what is
 /// missing.
 #[cfg(feature = "burn-gpu")]
-fn gpu() -> Result<Device> {
+pub fn gpu() -> Result<Device> {
     use std::sync::{Arc, Mutex};
     let device = Device::vulkan(::burn::tensor::DeviceKind::DefaultDevice);
     let probe = device.clone();
