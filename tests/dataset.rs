@@ -253,7 +253,7 @@ fn bad_shard_is_refused() {
     )
     .unwrap_err()
     .to_string();
-    assert!(e.contains("--shard"), "{e}");
+    assert!(e.contains("shard 3/2") && e.contains("1 ≤ i ≤ N"), "{e}");
 }
 
 /// Every per-condition key of a plan is read, and a bad one is refused with the file and key.
@@ -409,7 +409,7 @@ fn float32_subset_keeps_values_to_float32_precision() {
     .unwrap_err()
     .to_string();
     assert!(
-        err.contains("data-set options") && err.contains("another --out"),
+        err.contains("data-set options") && err.contains("another folder"),
         "{err}"
     );
 }

@@ -78,7 +78,7 @@ fn bad_input_gets_a_clear_error() {
     let mut slow = good.clone();
     slow.time = (0..slow.time.len()).map(|i| i as f64 * 0.01).collect();
     let e = check(&slow, &m, false).unwrap_err().to_string();
-    assert!(e.contains("100.0 Hz") && e.contains("--resample"), "{e}");
+    assert!(e.contains("100.0 Hz") && e.contains("resampling"), "{e}");
     // Resampling a 100 Hz record gives a 200 Hz one of the same span.
     let r = check(&slow, &m, true).unwrap();
     assert_eq!(r.time.len(), 2 * slow.time.len() - 1);

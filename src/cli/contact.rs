@@ -3,8 +3,8 @@
 use anyhow::{Result, bail};
 use clap::Args;
 use railforce::contact::{
-    CREEP_SPEED_FLOOR, ContactModel, CreepLaw, Material, Side, WheelOnRail, WheelsetGeometry,
-    evaluate, height_for_load, profile,
+    CREEP_SPEED_FLOOR, ContactModel, CreepLaw, Material, QuasiStatic, Side, WheelsetGeometry,
+    WheelsetState, profile,
 };
 use std::path::PathBuf;
 
@@ -117,98 +117,16 @@ pub struct ContactArgs {
     out: Option<PathBuf>,
 }
 
-/// Everything a contact state needs, from the vehicle or the options.
-struct Setup {
-    table: railforce::contact::ContactTable,
-    model: ContactModel,
-    /// Half the wheelset mass (for the contact damping), kg.
-    mass: f64,
-    /// Nominal rolling radius, m.
-    r0: f64,
-    /// Vertical load per wheel, N.
-    load: f64,
-    /// Flange angle for Nadal's limit, rad.
-    flange_angle: f64,
-}
-
-/// One wheel of a solved state.
-struct WheelResult {
-    side: Side,
-    forces: railforce::contact::WheelForces,
-    /// Approach of the wheelset centre below its rigid height, m.
-    approach: f64,
-}
-
-/// The state's rigid roll and height, the spin used, and both wheels' forces.
-struct StateResult {
-    roll: f64,
-    height: f64,
-    spin: f64,
-    /// Mean rolling radius of the two wheels at this shift, m (NaN when the spin was given).
-    rolling_radius: f64,
-    wheels: Vec<WheelResult>,
-}
-
-fn solve(setup: &Setup, args: &ContactArgs, y: f64, yaw: f64) -> StateResult {
-    let rigid = setup.table.lookup(y);
-    let speed = args.speed_kmh / 3.6;
-    let wheels_at = |spin: f64| -> Vec<WheelResult> {
-        [Side::Left, Side::Right]
-            .into_iter()
-            .map(|side| {
-                let mut w = WheelOnRail::rolling(side, speed, setup.r0, 0.0, setup.mass);
-                w.y = y;
-                w.yaw = yaw;
-                w.roll = rigid.roll + args.extra_roll_mrad * 1e-3;
-                w.velocity = [
-                    speed * yaw.cos() - args.lateral_velocity * yaw.sin(),
-                    speed * yaw.sin() + args.lateral_velocity * yaw.cos(),
-                    0.0,
-                ];
-                w.angular_velocity = [-spin * yaw.sin(), spin * yaw.cos(), args.yaw_rate];
-                w.height = height_for_load(&setup.table, &setup.model, &w, setup.load);
-                WheelResult {
-                    side,
-                    forces: evaluate(&setup.table, &setup.model, &w),
-                    approach: rigid.z - w.height,
-                }
-            })
-            .collect()
-    };
-    // Default spin: rolling at the mean of the two wheels' actual rolling radii at this
-    // shift — the load centres of their elastic patches (one refinement from the rigid
-    // contacts' radii) — so a centred wheelset rolls without longitudinal creep.
-    let (spin, rolling_radius, wheels) = match args.spin {
-        Some(spin) => (spin, f64::NAN, wheels_at(spin)),
-        None => {
-            let mut r = 0.5 * (rigid.wheels[0].rolling_radius + rigid.wheels[1].rolling_radius);
-            let mut wheels = wheels_at(speed / r);
-            let radii: Vec<f64> = wheels
-                .iter()
-                .filter_map(|w| w.forces.main().map(|p| p.radius))
-                .collect();
-            if radii.len() == 2 {
-                r = 0.5 * (radii[0] + radii[1]);
-                wheels = wheels_at(speed / r);
-            }
-            (speed / r, r, wheels)
-        }
-    };
-    StateResult {
-        roll: rigid.roll,
-        height: rigid.z,
-        spin,
-        rolling_radius,
-        wheels,
-    }
-}
-
-/// |Y|/Q of a wheel (NaN when it carries no load).
-fn y_over_q(f: &railforce::contact::WheelForces) -> f64 {
-    if f.force[2] > 1.0 {
-        f.force[1].abs() / f.force[2]
-    } else {
-        f64::NAN
+/// The state the options describe at shift `y` and yaw `yaw` (m, rad).
+fn state(args: &ContactArgs, y: f64, yaw: f64) -> WheelsetState {
+    WheelsetState {
+        y,
+        yaw,
+        extra_roll: args.extra_roll_mrad * 1e-3,
+        speed: args.speed_kmh / 3.6,
+        lateral_velocity: args.lateral_velocity,
+        yaw_rate: args.yaw_rate,
+        spin: args.spin,
     }
 }
 
@@ -246,7 +164,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
         bail!("--load-kn, --speed-kmh and --mu must be positive");
     }
     let setup = match &vehicle {
-        Some(v) => Setup {
+        Some(v) => QuasiStatic {
             table: v.contact.table().clone(),
             model: v.contact.model(),
             mass: 0.5 * v.bodies[v.contact.wheelsets[0]].mass,
@@ -258,7 +176,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
             let law = CreepLaw::parse(&args.law)
                 .ok_or_else(|| anyhow::anyhow!("--law must be polach, fastsim or linear"))?;
             let geo = args.wheelset.geometry()?;
-            Setup {
+            QuasiStatic {
                 table: geo.table(
                     railforce::vehicle::ContactSettings::TABLE_RANGE,
                     railforce::vehicle::ContactSettings::TABLE_STEP,
@@ -287,7 +205,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
     }
     let y = args.y_mm * 1e-3;
     let yaw = args.yaw_mrad * 1e-3;
-    let st = solve(&setup, &args, y, yaw);
+    let st = setup.solve(&state(&args, y, yaw));
     println!(
         "wheelset y {:+.2} mm, yaw {:+.2} mrad → rigid roll {:+.4} mrad (+ {:+.3} given), centre height {:.3} mm",
         args.y_mm,
@@ -327,7 +245,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
         "{:<11} {:>8} {:>8} {:>9} {:>8} {:>8} {:>6} {:>6} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8}",
         "", "um", "mm", "mm", "deg", "kN", "mm", "mm", "MPa", "", "", "1/m", "kN", "kN", "kN", "kN"
     );
-    let limit = railforce::contact::nadal_limit(setup.flange_angle, setup.model.friction);
+    let limit = setup.nadal_limit();
     for wr in &st.wheels {
         let f = &wr.forces;
         let name = if wr.side == Side::Left {
@@ -357,7 +275,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
                 p.force[2] * 1e-3
             );
         }
-        let yq = y_over_q(f);
+        let yq = f.y_over_q();
         println!(
             "{:<11} wheel total Y {:+.2} kN, Q {:.2} kN, |Y|/Q {:.3} over {} patch(es)",
             "",
@@ -413,7 +331,7 @@ struct SweepRow {
     beyond_nadal: bool,
 }
 
-fn sweep(setup: &Setup, args: &ContactArgs) -> Result<()> {
+fn sweep(setup: &QuasiStatic, args: &ContactArgs) -> Result<()> {
     let ys = match &args.sweep_y {
         Some(r) => range(r, "--sweep-y")?,
         None => vec![args.y_mm],
@@ -422,7 +340,7 @@ fn sweep(setup: &Setup, args: &ContactArgs) -> Result<()> {
         Some(r) => range(r, "--sweep-yaw")?,
         None => vec![args.yaw_mrad],
     };
-    let limit = railforce::contact::nadal_limit(setup.flange_angle, setup.model.friction);
+    let limit = setup.nadal_limit();
     let range_mm = railforce::vehicle::ContactSettings::TABLE_RANGE * 1e3;
     if let Some(y) = ys.iter().find(|y| y.abs() > range_mm) {
         bail!("--sweep-y reaches {y} mm, beyond the contact table's ±{range_mm:.0} mm");
@@ -430,10 +348,10 @@ fn sweep(setup: &Setup, args: &ContactArgs) -> Result<()> {
     let mut rows = Vec::new();
     for &yaw in &yaws {
         for &y in &ys {
-            let st = solve(setup, args, y * 1e-3, yaw * 1e-3);
+            let st = setup.solve(&state(args, y * 1e-3, yaw * 1e-3));
             for wr in &st.wheels {
                 let f = &wr.forces;
-                let yq = y_over_q(f);
+                let yq = f.y_over_q();
                 rows.push(SweepRow {
                     y_mm: y,
                     yaw_mrad: yaw,

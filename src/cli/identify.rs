@@ -4,10 +4,10 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use railforce::identify::safety::{IndexReport, Limits, Monitor};
-use railforce::identify::{SensorTable, Streamer, check, identify};
+use railforce::identify::{SensorRows, SensorTable, Streamer, check, identify};
 use railforce::learn::model::Model;
 use std::fmt::Write as _;
-use std::io::{BufRead, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Limits of the safety indices: by default the `[chinese]` table of the assessment criteria
@@ -96,7 +96,13 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
         return stream(&mut model, &args.out, &limits);
     }
     let table = SensorTable::read(&args.input)?;
-    let input = check(&table, &model, args.resample)?;
+    let input = check(&table, &model, args.resample).map_err(|e| {
+        if args.resample {
+            anyhow::anyhow!(e)
+        } else {
+            anyhow::anyhow!("{e}; --resample interpolates a record onto the model's rate")
+        }
+    })?;
     let t0 = std::time::Instant::now();
     let id = identify(&mut model, &input);
     let secs = t0.elapsed().as_secs_f64();
@@ -233,28 +239,9 @@ pub fn print_safety(reports: &[IndexReport], limits: &Limits) {
 /// the safety indices, as soon as its window is full (the same row text as a batch run), and
 /// the exceedance report at the end of the stream.
 fn stream(model: &mut Model, out: &Path, limits: &Limits) -> Result<()> {
-    let stdin = std::io::stdin();
-    let mut lines = stdin.lock().lines();
-    let header_line = lines
-        .next()
-        .context("stdin: empty input: expected a CSV header")??;
-    let names: Vec<String> = header_line
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
-    let time_k = names
-        .iter()
-        .position(|n| railforce::identify::TIME_COLUMNS.contains(&n.as_str()))
-        .with_context(|| {
-            format!(
-                "stdin: no time column (expected one of {})",
-                railforce::identify::TIME_COLUMNS.join(", ")
-            )
-        })?;
-    let s_k = names.iter().position(|n| n == "s_m");
+    let mut rows = SensorRows::new(std::io::stdin().lock(), "stdin", model)?;
+    let has_position = rows.has_position();
     let spec = model.meta.data.clone();
-    let head: Vec<&str> = names.iter().map(String::as_str).collect();
-    let pick = railforce::identify::resolve_channels(&head, model, "stdin")?;
     let mut w: Box<dyn Write> = if out.as_os_str() == "-" {
         Box::new(std::io::stdout().lock())
     } else {
@@ -263,58 +250,21 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits) -> Result<()> {
         ))
     };
     let mut monitor = Monitor::new(&spec.targets, limits, false);
-    w.write_all(header(&spec.targets, s_k.is_some(), &monitor.columns()).as_bytes())?;
+    w.write_all(header(&spec.targets, has_position, &monitor.columns()).as_bytes())?;
     let off = railforce::learn::windows::label_offset(spec.window, spec.label_at);
     let mut positions = std::collections::VecDeque::with_capacity(spec.window);
     let mut st = Streamer::new(model);
-    let mut values = vec![0.0; pick.len()];
-    let mut last_t: Option<f64> = None;
-    for (r, line) in lines.enumerate() {
-        let line = line?;
-        let row_no = r + 1;
-        let fields: Vec<&str> = line.split(',').collect();
-        // The batch reader's wording: source, column, row (from 1 after the header).
-        let num = |k: usize, name: &str| -> Result<f64> {
-            let v: f64 = fields
-                .get(k)
-                .and_then(|s| s.trim().parse().ok())
-                .with_context(|| {
-                    format!("stdin: column {name}, row {row_no}: missing or not a number")
-                })?;
-            if !v.is_finite() {
-                bail!("stdin: column {name}, row {row_no}: value {v} is not a finite number");
-            }
-            Ok(v)
-        };
-        let t = num(time_k, &names[time_k])?;
-        if let Some(p) = last_t
-            && !railforce::identify::is_regular_step(t - p)
-        {
-            let step = t - p;
-            bail!(
-                "stdin: time column, rows {}–{row_no}: step {step:.6} s ({:.1} Hz); the model needs {} Hz without gaps",
-                row_no - 1,
-                if step > 0.0 {
-                    1.0 / step
-                } else {
-                    f64::INFINITY
-                },
-                railforce::identify::RATE_HZ
-            );
-        }
-        last_t = Some(t);
-        for (v, &k) in values.iter_mut().zip(&pick) {
-            *v = num(k, &names[k])?;
-        }
-        if let Some(k) = s_k {
-            positions.push_back(num(k, "s_m")?);
+    let mut values = vec![0.0; spec.channels.len()];
+    while let Some((t, s)) = rows.next_row(&mut values)? {
+        if let Some(s) = s {
+            positions.push_back(s);
             if positions.len() > spec.window {
                 positions.pop_front();
             }
         }
         if let Some((tl, f)) = st.push(t, &values) {
             let idx = monitor.push(tl, &f);
-            let p = s_k.map(|_| positions[off]);
+            let p = has_position.then(|| positions[off]);
             w.write_all(row(tl, p, &f, &idx).as_bytes())?;
             w.flush()?;
         }

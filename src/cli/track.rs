@@ -34,7 +34,7 @@ pub fn run(args: TrackArgs) -> Result<()> {
     if let Some(out) = &args.out {
         track
             .write_csv(out, args.step)
-            .with_context(|| format!("exporting {}", args.file.display()))?;
+            .with_context(|| format!("exporting {} every --step m", args.file.display()))?;
         println!("wrote {} (every {} m)", out.display(), args.step);
     }
     if args.psd {

@@ -5,11 +5,11 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use railforce::dataset::DataSet;
-use railforce::features::{LabelAt, NoiseProtocol, Selection, Split};
+use railforce::features::{LabelAt, NoiseProtocol, Selection, Split, SplitRequest};
 use railforce::learn::evaluate::{EvalPart, evaluate};
 use railforce::learn::model::{Model, ModelKind};
 use railforce::learn::train::{GradientEngine, Progress, TrainOptions, train};
-use railforce::learn::windows::DataSpec;
+use railforce::learn::windows::{DataRequest, DataSpec};
 use railforce::sensors::PAPER_CHANNELS;
 use std::path::{Path, PathBuf};
 
@@ -38,7 +38,7 @@ pub struct DataArgs {
     /// train), `blocks` (70/15/15 % contiguous blocks of every run: the default with fewer
     /// seeds), `conditions` (with --test-conditions) or `shuffled` (stride-1 windows shuffled
     /// 70/15/15: leaky, for comparison only).
-    #[arg(long, value_parser = ["seeds", "blocks", "conditions", "shuffled"])]
+    #[arg(long, value_parser = railforce::features::SPLIT_KINDS)]
     pub split: Option<String>,
     /// Training seeds of the seed split (comma separated), instead of all but the last two.
     #[arg(long, value_delimiter = ',')]
@@ -121,14 +121,12 @@ pub struct TrainArgs {
     engine: String,
 }
 
-/// Resolves the data options into a [`DataSpec`].
+/// The data options as the library's request: the selection file's channels, window and
+/// label position (or the paper's 21, 20, last), then the flags that override them.
 pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
-    let (mut channels, window, label_at) = match &args.selection {
+    let (channels, window, label_at) = match &args.selection {
         Some(p) => {
-            let text =
-                std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
-            let s: Selection = serde_json::from_str(&text)
-                .with_context(|| format!("{}: not a selection file", p.display()))?;
+            let s = Selection::load(p)?;
             (s.channels, s.window, s.label_at)
         }
         None => (
@@ -137,115 +135,42 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
             LabelAt::Last,
         ),
     };
-    let window = args.window.unwrap_or(window);
-    let label_at = if args.centre_label {
-        LabelAt::Centre
-    } else {
-        label_at
-    };
-    for c in &mut channels {
-        if let Some(base) = c.strip_suffix("_noisy") {
-            *c = base.to_string();
-        }
-    }
-    let targets = ds.targets(&args.target)?;
-    // A noised data set (generate --snr-db) trains on noisy inputs; copies it lacks (the
-    // on-board candidates) are drawn in memory with its noise model (see `with_noisy_copies`).
-    let has_noisy = ds.noise.is_some()
-        || channels
-            .iter()
-            .all(|c| ds.channel(&format!("{c}_noisy")).is_ok());
     let noise = match args.noise.as_deref() {
-        None if has_noisy => NoiseProtocol::Matched,
-        None => NoiseProtocol::Clean,
-        Some(o) => NoiseProtocol::parse(o).ok_or_else(|| {
+        None => None,
+        Some(o) => Some(NoiseProtocol::parse(o).ok_or_else(|| {
             anyhow::anyhow!("--noise {o}: expected clean, matched or train-clean-test-noisy")
-        })?,
+        })?),
     };
-    let split = split(args, ds)?;
-    Ok(DataSpec {
+    let req = DataRequest {
         channels,
-        targets,
-        window,
-        label_at,
-        stride: args.stride,
-        split,
-        noise,
-        noise_model: if noise == NoiseProtocol::Clean {
-            None
+        targets: args.target.clone(),
+        window: args.window.unwrap_or(window),
+        label_at: if args.centre_label {
+            LabelAt::Centre
         } else {
-            ds.noise
+            label_at
         },
-    })
+        stride: args.stride,
+        split: split(args, ds)?,
+        noise,
+    };
+    DataSpec::resolve(&req, ds).context("--target, --window or --stride")
 }
 
-/// Resolves the split options against the data set's seeds.
+/// The split flags resolved against the data set's seeds and conditions (the library's
+/// [`Split::resolve`]); its errors get the flags to use.
 pub fn split(args: &DataArgs, ds: &DataSet) -> Result<Split> {
-    let seeds_given =
-        !(args.train_seeds.is_empty() && args.val_seeds.is_empty() && args.test_seeds.is_empty());
-    let kind = match args.split.as_deref() {
-        Some(k) => k,
-        None if !args.test_conditions.is_empty() => "conditions",
-        None if seeds_given => "seeds",
-        None => return Ok(Split::standard(ds)),
+    let req = SplitRequest {
+        kind: args.split.clone(),
+        train_seeds: args.train_seeds.clone(),
+        val_seeds: args.val_seeds.clone(),
+        test_seeds: args.test_seeds.clone(),
+        val_conditions: args.val_conditions.clone(),
+        test_conditions: args.test_conditions.clone(),
     };
-    let split = match kind {
-        "blocks" => Split::default(),
-        "shuffled" => Split::shuffled(1),
-        "conditions" => {
-            if args.test_conditions.is_empty() {
-                bail!("--split conditions needs --test-conditions (and --val-conditions)");
-            }
-            let mut known: Vec<&str> = ds.runs.iter().map(|r| r.condition.as_str()).collect();
-            known.sort_unstable();
-            known.dedup();
-            for (flag, list) in [
-                ("--test-conditions", &args.test_conditions),
-                ("--val-conditions", &args.val_conditions),
-            ] {
-                if let Some(c) = list.iter().find(|c| !known.contains(&c.as_str())) {
-                    bail!(
-                        "{flag}: unknown condition {c}; {} has: {}",
-                        ds.dir.display(),
-                        known.join(", ")
-                    );
-                }
-            }
-            Split::Conditions {
-                val: args.val_conditions.clone(),
-                test: args.test_conditions.clone(),
-            }
-        }
-        _ => {
-            let all = ds.seeds();
-            let (mut train, mut val, mut test) = match Split::standard(ds) {
-                Split::Seeds { train, val, test } => (train, val, test),
-                _ if seeds_given => (Vec::new(), Vec::new(), Vec::new()),
-                _ => bail!(
-                    "--split seeds needs three or more seeds in {} (it has {:?}); generate more with the plan's `seeds`, or give --train-seeds/--val-seeds/--test-seeds",
-                    ds.dir.display(),
-                    all
-                ),
-            };
-            for (given, part) in [
-                (&args.train_seeds, &mut train),
-                (&args.val_seeds, &mut val),
-                (&args.test_seeds, &mut test),
-            ] {
-                if !given.is_empty() {
-                    *part = given.clone();
-                }
-            }
-            for s in train.iter().chain(&val).chain(&test) {
-                if !all.contains(s) {
-                    bail!("seed {s} is not in {} (it has {:?})", ds.dir.display(), all);
-                }
-            }
-            Split::Seeds { train, val, test }
-        }
-    };
-    split.check()?;
-    Ok(split)
+    Ok(Split::resolve(&req, ds).context(
+        "--split, --train-seeds/--val-seeds/--test-seeds or --test-conditions/--val-conditions",
+    )?)
 }
 
 /// `ds` with `<channel>_noisy` copies of every channel of `channels` that lacks one, drawn

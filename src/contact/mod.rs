@@ -6,6 +6,7 @@ pub mod geometry;
 pub mod hertz;
 pub mod kalker;
 pub mod profile;
+mod quasi_static;
 mod table;
 pub mod validate;
 pub mod wheel_rail;
@@ -15,6 +16,7 @@ pub use geometry::{ContactState, Side, WheelContact, WheelsetGeometry};
 pub use hertz::{HertzEllipse, HertzShape, Material};
 pub use kalker::KalkerCoefficients;
 pub use profile::Profile;
+pub use quasi_static::{QuasiStatic, StateResult, WheelResult, WheelsetState};
 pub use table::ContactTable;
 pub use wheel_rail::{
     CREEP_SPEED_FLOOR, ContactFrame, ContactModel, PatchForce, WheelForces, WheelOnRail, evaluate,

@@ -118,6 +118,15 @@ pub struct WheelForces {
 }
 
 impl WheelForces {
+    /// |Y|/Q of the wheel (NaN when it carries no load).
+    pub fn y_over_q(&self) -> f64 {
+        if self.force[2] > 1.0 {
+            self.force[1].abs() / self.force[2]
+        } else {
+            f64::NAN
+        }
+    }
+
     /// The patch with the larger load.
     pub fn main(&self) -> Option<&PatchForce> {
         self.patches[0].as_ref()

@@ -369,7 +369,7 @@ pub(super) fn refuse_mixing(
         return Ok(());
     }
     Err(Error::Domain(format!(
-        "{} holds a data set with {}: write to another --out folder, or delete that folder to start again (runs are never mixed)",
+        "{} holds a data set with {}: write to another folder, or delete that folder to start again (runs are never mixed)",
         manifest.display(),
         differ.join(" and ")
     )))

@@ -16,7 +16,7 @@ pub use manifest::{
     file_hash, fnv1a, manifest_path, merge, run_entry,
 };
 use manifest::{refuse_mixing, run_key};
-pub use table::{read_csv, read_table};
+pub use table::{not_a_number, read_csv, read_table, row_length};
 
 use crate::error::{Error, Result};
 use crate::plan::{Condition, Plan};
@@ -164,14 +164,14 @@ pub fn generate(
         && !(n >= 1 && (1..=n).contains(&i))
     {
         return Err(Error::Domain(format!(
-            "--shard must be i/N with 1 ≤ i ≤ N, got {i}/{n}"
+            "shard {i}/{n}: a shard is i/N with 1 ≤ i ≤ N"
         )));
     }
     if let Some(n) = opts.noise
         && !n.snr_db.is_finite()
     {
         return Err(Error::Domain(format!(
-            "--snr-db must be finite, got {}",
+            "the SNR must be finite, got {} dB",
             n.snr_db
         )));
     }
@@ -455,7 +455,7 @@ fn keep_channels(
         let named = rec.names.iter().any(|n| n == k) || CHANNEL_KINDS.contains(&k.as_str());
         if !named {
             return Err(format!(
-                "\"{k}\" is neither a channel of this vehicle nor a kind ({}); channels are listed by `railforce simulate --list-channels`",
+                "\"{k}\" is neither a channel of this vehicle nor a kind ({}); a data set's manifest lists them under `channels`",
                 CHANNEL_KINDS.join(", ")
             ));
         }

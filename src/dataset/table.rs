@@ -58,28 +58,34 @@ pub fn read_csv(bytes: &[u8], file: &Path) -> Result<Vec<(String, Vec<f64>)>> {
     for (ln, line) in lines.enumerate() {
         let fields = line.split(',').count();
         if fields != header.len() {
-            return Err(parse_err(format!(
-                "row {} has {fields} field(s) but the header names {} columns{}",
-                ln + 1,
-                header.len(),
-                if fields < header.len() {
-                    " (the file may be cut short)"
-                } else {
-                    ""
-                }
-            )));
+            return Err(parse_err(row_length(ln + 1, fields, header.len())));
         }
         for (k, v) in line.split(',').enumerate() {
             let x: f64 = v.parse().map_err(|_| {
                 // The same wording as the identify checks: column, row from 1 after the header.
-                parse_err(format!(
-                    "column {}, row {}: \"{v}\" is not a number",
-                    header[k],
-                    ln + 1
-                ))
+                parse_err(not_a_number(&header[k], ln + 1, v))
             })?;
             cols[k].push(x);
         }
     }
     Ok(header.into_iter().zip(cols).collect())
+}
+
+/// What a CSV row of the wrong length is told, for every CSV reader (batch and stream): row
+/// counted from 1 after the header.
+pub fn row_length(row: usize, fields: usize, columns: usize) -> String {
+    format!(
+        "row {row} has {fields} field(s) but the header names {columns} columns{}",
+        if fields < columns {
+            " (the file may be cut short)"
+        } else {
+            ""
+        }
+    )
+}
+
+/// What a field that is not a number is told, for every CSV reader: column and row (from 1
+/// after the header).
+pub fn not_a_number(column: &str, row: usize, field: &str) -> String {
+    format!("column {column}, row {row}: \"{field}\" is not a number")
 }

@@ -44,12 +44,12 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             jobs.push(FitJob {
                 ds: &dsc,
                 spec: ctx.spec(
+                    &dsc,
                     &inputs,
                     std::slice::from_ref(&labels[k]),
                     NoiseProtocol::Matched,
                     ctx.split.clone(),
-                    Some(opts.snr_db),
-                ),
+                )?,
                 kind,
                 dir: dir
                     .join("models")

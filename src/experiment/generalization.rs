@@ -17,12 +17,12 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let dsn = ctx.noisy(&ctx.ds, opts.snr_db, &inputs)?;
     let dir = opts.out.join("generalization");
     let sp = ctx.spec(
+        &dsn,
         &inputs,
         &labels,
         NoiseProtocol::Matched,
         ctx.split.clone(),
-        Some(opts.snr_db),
-    );
+    )?;
     let conditions = ctx.conditions.clone();
     let loco: Vec<String> = if opts.loco.is_empty() {
         ["curve_r400_v60", "tangent_v80", "grade20_L50_v60"]
@@ -54,6 +54,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         jobs.push(FitJob {
             ds: &dsn,
             spec: ctx.spec(
+                &dsn,
                 &inputs,
                 &labels,
                 NoiseProtocol::Matched,
@@ -61,8 +62,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     val: vec![val.clone()],
                     test: vec![c.clone()],
                 },
-                Some(opts.snr_db),
-            ),
+            )?,
             kind: ModelKind::CnnBiLstm,
             dir: dir.join(format!("models/without_{c}")),
             windows: None,

@@ -22,7 +22,7 @@ use crate::features::{LabelAt, NoiseProtocol, Split};
 use crate::learn::metrics::{Metrics, metrics};
 use crate::learn::model::{Model, ModelKind};
 use crate::learn::train::{EpochLog, Progress, TrainOptions, train};
-use crate::learn::windows::{DataSpec, prepare};
+use crate::learn::windows::{DataRequest, DataSpec, prepare};
 use crate::plan::Plan;
 use crate::report::write_index;
 use crate::sensors::{Candidates, NoiseModel, PAPER_CHANNELS, SnrReference};
@@ -186,25 +186,26 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    /// Data spec of a model over `channels` predicting `targets`.
+    /// Data spec of a model over `channels` predicting `targets` on `ds` (the one
+    /// [`DataSpec::resolve`]: its noise model is the one `ds` was noised with).
     fn spec(
         &self,
+        ds: &DataSet,
         channels: &[String],
         targets: &[String],
         noise: NoiseProtocol,
         split: Split,
-        snr: Option<f64>,
-    ) -> DataSpec {
-        DataSpec {
+    ) -> Result<DataSpec> {
+        let req = DataRequest {
             channels: channels.to_vec(),
-            targets: targets.to_vec(),
+            targets: targets.join(","),
             window: self.opts.window,
             label_at: self.opts.label_at,
             stride: 1,
             split,
-            noise,
-            noise_model: snr.map(|s| self.opts.noise(s)),
-        }
+            noise: Some(noise),
+        };
+        DataSpec::resolve(&req, ds)
     }
 
     /// The paper's 21 inputs.

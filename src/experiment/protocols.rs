@@ -59,20 +59,22 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let jobs: Vec<FitJob> = splits
         .iter()
         .filter(|(name, _)| !(*name == "seeds" && ctx.pooled.is_some()))
-        .map(|(_, split)| FitJob {
-            ds: &dsn,
-            spec: ctx.spec(
-                &inputs,
-                &labels,
-                NoiseProtocol::Matched,
-                split.clone(),
-                Some(opts.snr_db),
-            ),
-            kind: ModelKind::CnnBiLstm,
-            dir: dir.join(format!("models/{}", split.name())),
-            windows: None,
+        .map(|(_, split)| {
+            Ok(FitJob {
+                ds: &dsn,
+                spec: ctx.spec(
+                    &dsn,
+                    &inputs,
+                    &labels,
+                    NoiseProtocol::Matched,
+                    split.clone(),
+                )?,
+                kind: ModelKind::CnnBiLstm,
+                dir: dir.join(format!("models/{}", split.name())),
+                windows: None,
+            })
         })
-        .collect();
+        .collect::<Result<Vec<_>>>()?;
     let mut fitted = ctx.fit_all(&jobs)?.into_iter();
     for (name, split) in splits {
         let e = match (&ctx.pooled, name) {

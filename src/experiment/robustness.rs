@@ -42,12 +42,12 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         jobs.push(FitJob {
             ds: &base,
             spec: ctx.spec(
+                &base,
                 &inputs,
                 &labels,
                 NoiseProtocol::Clean,
                 ctx.split.clone(),
-                None,
-            ),
+            )?,
             kind,
             dir: dir.join(format!("models/clean_{}", kind.name())),
             windows,
@@ -58,12 +58,12 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             jobs.push(FitJob {
                 ds: dsn,
                 spec: ctx.spec(
+                    dsn,
                     &inputs,
                     &labels,
                     NoiseProtocol::Matched,
                     ctx.split.clone(),
-                    Some(snr),
-                ),
+                )?,
                 kind,
                 dir: dir.join(format!("models/matched_{}_{snr}dB", kind.name())),
                 windows,

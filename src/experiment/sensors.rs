@@ -109,27 +109,29 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let jobs: Vec<FitJob> = cases
         .iter()
         .filter(|(snr, name, _, _)| !reused(*snr, name))
-        .map(|&(snr, name, inputs, i)| FitJob {
-            ds: sets[i],
-            spec: ctx.spec(
-                inputs,
-                &labels,
-                NoiseProtocol::Matched,
-                ctx.split.clone(),
-                Some(snr),
-            ),
-            kind: ModelKind::CnnBiLstm,
-            dir: dir.join(format!(
-                "models/{}_{snr}dB",
-                if name == "paper's 21" {
-                    "paper21"
-                } else {
-                    "selected"
-                }
-            )),
-            windows: None,
+        .map(|&(snr, name, inputs, i)| {
+            Ok(FitJob {
+                ds: sets[i],
+                spec: ctx.spec(
+                    sets[i],
+                    inputs,
+                    &labels,
+                    NoiseProtocol::Matched,
+                    ctx.split.clone(),
+                )?,
+                kind: ModelKind::CnnBiLstm,
+                dir: dir.join(format!(
+                    "models/{}_{snr}dB",
+                    if name == "paper's 21" {
+                        "paper21"
+                    } else {
+                        "selected"
+                    }
+                )),
+                windows: None,
+            })
         })
-        .collect();
+        .collect::<Result<Vec<_>>>()?;
     let mut fitted = ctx.fit_all(&jobs)?.into_iter();
     for &(snr, name, inputs, i) in &cases {
         let e = match &ctx.pooled {

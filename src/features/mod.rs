@@ -7,6 +7,7 @@ pub mod split;
 pub mod wrapper;
 
 pub use samples::{Block, LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
+pub use split::{SPLIT_KINDS, SplitRequest};
 
 use crate::dataset::DataSet;
 use crate::error::{Error, Result};
@@ -47,6 +48,17 @@ pub struct Selection {
     pub mi_threshold: f64,
     /// Wrapper stopping tolerance on R².
     pub tolerance: f64,
+}
+
+impl Selection {
+    /// Reads a selection file written by `railforce select`; errors name the file.
+    pub fn load(path: &std::path::Path) -> Result<Self> {
+        let text = crate::io::read_text(path)?;
+        serde_json::from_str(&text).map_err(|e| Error::Parse {
+            file: path.to_path_buf(),
+            message: format!("not a selection file: {e}"),
+        })
+    }
 }
 
 /// Settings of a selection.

@@ -164,3 +164,112 @@ impl Split {
         }
     }
 }
+
+/// What a user asks of the split, before it is resolved against a data set: a kind
+/// (`seeds`, `blocks`, `conditions`, `shuffled`; none: the protocol's default), seeds for the
+/// seed split's parts, conditions held out.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SplitRequest {
+    /// The kind, as named in [`Split::name`]; `None`: from what else is given.
+    pub kind: Option<String>,
+    /// Training seeds instead of all but the last two.
+    pub train_seeds: Vec<u64>,
+    /// Validation seeds instead of the one before last.
+    pub val_seeds: Vec<u64>,
+    /// Test seeds instead of the last.
+    pub test_seeds: Vec<u64>,
+    /// Conditions held out for validation.
+    pub val_conditions: Vec<String>,
+    /// Conditions held out for the test.
+    pub test_conditions: Vec<String>,
+}
+
+/// The kinds a [`SplitRequest`] names.
+pub const SPLIT_KINDS: [&str; 4] = ["seeds", "blocks", "conditions", "shuffled"];
+
+impl Split {
+    /// Resolves `req` against the data set's seeds and conditions: held-out conditions give
+    /// the condition split, given seeds the seed split, nothing the protocol's default
+    /// ([`Split::standard`]). Every seed and condition must be in the data set, and no seed
+    /// serves two parts.
+    pub fn resolve(req: &SplitRequest, ds: &DataSet) -> Result<Split> {
+        let seeds_given =
+            !(req.train_seeds.is_empty() && req.val_seeds.is_empty() && req.test_seeds.is_empty());
+        let kind = match req.kind.as_deref() {
+            Some(k) => k,
+            None if !req.test_conditions.is_empty() => "conditions",
+            None if seeds_given => "seeds",
+            None => return Ok(Split::standard(ds)),
+        };
+        let split = match kind {
+            "blocks" => Split::default(),
+            "shuffled" => Split::shuffled(1),
+            "conditions" => {
+                if req.test_conditions.is_empty() {
+                    return Err(Error::Domain(
+                        "the condition split needs test conditions (and validation conditions)"
+                            .into(),
+                    ));
+                }
+                let mut known: Vec<&str> = ds.runs.iter().map(|r| r.condition.as_str()).collect();
+                known.sort_unstable();
+                known.dedup();
+                for (part, list) in [
+                    ("test conditions", &req.test_conditions),
+                    ("validation conditions", &req.val_conditions),
+                ] {
+                    if let Some(c) = list.iter().find(|c| !known.contains(&c.as_str())) {
+                        return Err(Error::Domain(format!(
+                            "{part}: unknown condition {c}; {} has: {}",
+                            ds.dir.display(),
+                            known.join(", ")
+                        )));
+                    }
+                }
+                Split::Conditions {
+                    val: req.val_conditions.clone(),
+                    test: req.test_conditions.clone(),
+                }
+            }
+            "seeds" => {
+                let all = ds.seeds();
+                let (mut train, mut val, mut test) = match Split::standard(ds) {
+                    Split::Seeds { train, val, test } => (train, val, test),
+                    _ if seeds_given => (Vec::new(), Vec::new(), Vec::new()),
+                    _ => {
+                        return Err(Error::Domain(format!(
+                            "the seed split needs three or more seeds in {} (it has {all:?}); generate more with the plan's `seeds`, or name the training, validation and test seeds",
+                            ds.dir.display()
+                        )));
+                    }
+                };
+                for (given, part) in [
+                    (&req.train_seeds, &mut train),
+                    (&req.val_seeds, &mut val),
+                    (&req.test_seeds, &mut test),
+                ] {
+                    if !given.is_empty() {
+                        *part = given.clone();
+                    }
+                }
+                for s in train.iter().chain(&val).chain(&test) {
+                    if !all.contains(s) {
+                        return Err(Error::Domain(format!(
+                            "seed {s} is not in {} (it has {all:?})",
+                            ds.dir.display()
+                        )));
+                    }
+                }
+                Split::Seeds { train, val, test }
+            }
+            other => {
+                return Err(Error::Domain(format!(
+                    "unknown split {other}: {}",
+                    SPLIT_KINDS.join(", ")
+                )));
+            }
+        };
+        split.check()?;
+        Ok(split)
+    }
+}

@@ -6,9 +6,11 @@
 
 pub mod check_report;
 pub mod closed_loop;
+mod stream;
 /// The safety indices live in [`crate::assess::safety`] (assess judges any force series);
 /// re-exported here, where the streaming identification uses them.
 pub use crate::assess::safety;
+pub use stream::SensorRows;
 
 use crate::error::{Error, Result};
 use crate::features::{LabelAt, Part};
@@ -144,12 +146,7 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
     for name in &used {
         let v = table.column(name).expect("checked above");
         if let Some(r) = v.iter().position(|x| !x.is_finite()) {
-            return Err(Error::Domain(format!(
-                "{}: column {name}, row {}: value {} is not a finite number",
-                table.source,
-                r + 1,
-                v[r]
-            )));
+            return Err(not_finite(&table.source, name, r + 1, v[r]));
         }
         columns.push(v.to_vec());
     }
@@ -180,22 +177,12 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
             columns,
             position,
         }),
-        Some(r) if !resample => {
-            let step = t[r + 1] - t[r];
-            let rate = if step > 0.0 {
-                1.0 / step
-            } else {
-                f64::INFINITY
-            };
-            Err(Error::Domain(format!(
-                "{}: time column, rows {}–{}: step {:.6} s ({:.1} Hz); the model needs {RATE_HZ} Hz without gaps (use --resample to interpolate onto 200 Hz)",
-                table.source,
-                r + 1,
-                r + 2,
-                step,
-                rate
-            )))
-        }
+        Some(r) if !resample => Err(irregular_step(
+            &table.source,
+            r + 1,
+            t[r + 1] - t[r],
+            " (resampling interpolates it onto 200 Hz)",
+        )),
         Some(_) => {
             if let Some(r) = t.windows(2).position(|w| w[1] <= w[0]) {
                 return Err(Error::Domain(format!(
@@ -216,6 +203,28 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
             })
         }
     }
+}
+
+/// A value that is not finite, named by source, column and row (from 1 after the header): the
+/// batch check's and the stream's one wording.
+fn not_finite(source: &str, column: &str, row: usize, value: f64) -> Error {
+    Error::Domain(format!(
+        "{source}: column {column}, row {row}: value {value} is not a finite number"
+    ))
+}
+
+/// A time step other than one 200 Hz interval between `row` and the next (from 1 after the
+/// header), with `hint` appended.
+fn irregular_step(source: &str, row: usize, step: f64, hint: &str) -> Error {
+    let rate = if step > 0.0 {
+        1.0 / step
+    } else {
+        f64::INFINITY
+    };
+    Error::Domain(format!(
+        "{source}: time column, rows {row}–{}: step {step:.6} s ({rate:.1} Hz); the model needs {RATE_HZ} Hz without gaps{hint}",
+        row + 1
+    ))
 }
 
 /// Linear interpolation of `(t, v)` at `at` (ascending, inside the range).

@@ -77,7 +77,7 @@ impl Stepper {
             other => {
                 let _ = config;
                 Err(Error::Domain(format!(
-                    "--engine {} needs burn, and this railforce was built without it: rebuild with `cargo build --release --features {}`",
+                    "the {} engine needs burn, and this railforce was built without it: rebuild with `cargo build --release --features {}`",
                     other.name(),
                     if other == GradientEngine::BurnGpu {
                         "burn-gpu"

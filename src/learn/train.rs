@@ -347,7 +347,7 @@ impl Trainer {
             return Err(Error::config(
                 &ck_path,
                 "fingerprint",
-                "the checkpoint belongs to another model, data set or setting; train without --resume or into another folder",
+                "the checkpoint belongs to another model, data set or setting; train anew (not resuming) or into another folder",
             ));
         }
         self.net.params.value = read_weights(&out.join("checkpoint_weights.bin"))?;
@@ -410,7 +410,7 @@ impl Trainer {
             let l = self.stepper.step(&mut self.net, x, y, chunk.len(), dout)?;
             if !l.is_finite() {
                 return Err(Error::Domain(format!(
-                    "training diverged at epoch {epoch}, batch {} (loss {l}); lower --lr",
+                    "training diverged at epoch {epoch}, batch {} (loss {l}); lower the learning rate",
                     bi + 1
                 )));
             }
@@ -441,7 +441,7 @@ impl Trainer {
         let val_loss = vm.iter().map(|m| m.mse).sum::<f64>() / vm.len() as f64;
         if !val_loss.is_finite() {
             return Err(Error::Domain(format!(
-                "validation loss is {val_loss} at epoch {epoch}; lower --lr"
+                "validation loss is {val_loss} at epoch {epoch}; lower the learning rate"
             )));
         }
         if val_loss < self.best_val {

@@ -37,6 +37,72 @@ pub struct DataSpec {
     pub noise_model: Option<NoiseModel>,
 }
 
+/// What a user or an experiment asks of a data set, before [`DataSpec::resolve`] checks it
+/// against the data and fills in the defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DataRequest {
+    /// Input channels (a `_noisy` suffix is dropped: the protocol says which copy is read).
+    pub channels: Vec<String>,
+    /// Targets, comma separated: `FL`, `FQ`, `both`, a wheel (`w1r`, `1R`) or channel names.
+    pub targets: String,
+    /// Steps per window.
+    pub window: usize,
+    /// Label position.
+    pub label_at: LabelAt,
+    /// Stride of training windows.
+    pub stride: usize,
+    /// The split ([`Split::resolve`] makes one from what a user asks).
+    pub split: Split,
+    /// The noise protocol; `None`: matched when the data set has noisy inputs, else clean.
+    pub noise: Option<NoiseProtocol>,
+}
+
+impl DataSpec {
+    /// The one place a data spec is made, for `train` and the experiments alike: targets
+    /// resolved against the data set's labels, the split checked (no seed in two parts),
+    /// the noise protocol (matched when the data set has noisy copies of the inputs, else
+    /// clean, unless asked) and the noise model the data set records (none for a clean model).
+    pub fn resolve(req: &DataRequest, ds: &DataSet) -> Result<DataSpec> {
+        let channels: Vec<String> = req
+            .channels
+            .iter()
+            .map(|c| c.strip_suffix("_noisy").unwrap_or(c).to_string())
+            .collect();
+        let targets = ds.targets(&req.targets)?;
+        let has_noisy = ds.noise.is_some()
+            || channels
+                .iter()
+                .all(|c| ds.channel(&crate::sensors::noisy_name(c)).is_ok());
+        let noise = match req.noise {
+            Some(n) => n,
+            None if has_noisy => NoiseProtocol::Matched,
+            None => NoiseProtocol::Clean,
+        };
+        if req.window == 0 || req.stride == 0 {
+            return Err(Error::Domain(
+                "the window and the stride must be at least one step".into(),
+            ));
+        }
+        Ok(DataSpec {
+            channels,
+            targets,
+            window: req.window,
+            label_at: req.label_at,
+            stride: req.stride,
+            split: {
+                req.split.check()?;
+                req.split.clone()
+            },
+            noise,
+            noise_model: if noise == NoiseProtocol::Clean {
+                None
+            } else {
+                ds.noise
+            },
+        })
+    }
+}
+
 /// Windows of one part.
 #[derive(Debug, Clone)]
 pub struct WindowSet {
@@ -151,7 +217,7 @@ pub fn prepare(
                 let name = spec.noise.column(c, part);
                 ds.channel(&name).map_err(|_| {
                     Error::Domain(format!(
-                        "the data set in {} has no column `{name}` (noise protocol {:?}; generate with --snr-db for `_noisy` inputs)",
+                        "the data set in {} has no column `{name}` (noise protocol {:?}; generate the data set with an SNR for `_noisy` inputs)",
                         ds.dir.display(),
                         spec.noise
                     ))

@@ -148,7 +148,7 @@ impl Track {
     pub fn write_csv(&self, path: &Path, step: f64) -> Result<()> {
         if !(step.is_finite() && step > 0.0) {
             return Err(Error::Domain(format!(
-                "--step must be positive, got {step}"
+                "the sampling step must be positive, got {step} m"
             )));
         }
         let n = (self.length() / step).floor() as usize;

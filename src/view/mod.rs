@@ -296,7 +296,7 @@ impl Scene {
                     .map(|(_, v)| v.as_slice())
                     .ok_or_else(|| {
                         Error::Domain(format!(
-                            "{src}: no time_s column: --identified takes the output of `railforce identify`"
+                            "{src}: no time_s column: identified forces are the output of `railforce identify`"
                         ))
                     })?;
                 let find = |comp: char| {
@@ -308,7 +308,7 @@ impl Scene {
                 let (iy, iq) = (find('y'), find('z'));
                 if iy.is_none() && iq.is_none() {
                     return Err(Error::Domain(format!(
-                        "{src}: neither w{label_key}_force_y_N nor w{label_key}_force_z_N: identify the label wheel {label} (--target FL, FQ or w{label_key})"
+                        "{src}: neither w{label_key}_force_y_N nor w{label_key}_force_z_N: identify the label wheel {label} (targets FL, FQ or w{label_key})"
                     )));
                 }
                 let series = |c: Option<&[f64]>| -> Vec<Option<f64>> {

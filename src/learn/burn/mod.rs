@@ -58,7 +58,7 @@ pub fn gpu() -> Result<Device> {
                 .and_then(|v| v.first().cloned())
                 .unwrap_or_default();
             Err(Error::Domain(format!(
-                "no GPU reachable through Vulkan for --engine burn-gpu (install the GPU's Vulkan driver and loader, libvulkan1; or use burn-cpu or fused): {said}"
+                "no GPU reachable through Vulkan for the burn-gpu engine (install the GPU's Vulkan driver and loader, libvulkan1; or use burn-cpu or fused): {said}"
             )))
         }
     }
