@@ -205,6 +205,12 @@ fn init(args: InitArgs) -> anyhow::Result<()> {
 }
 
 /// Parses the command line, runs the subcommand and turns errors into a message and exit 1.
+/// A library error with the flags that set what it names: `<what is wrong> (set by <flags>)`.
+/// The library says what is wrong in its own words; the command line adds where to change it.
+pub fn with_flags<T>(r: railforce::Result<T>, flags: &str) -> anyhow::Result<T> {
+    r.map_err(|e| anyhow::anyhow!("{e} (set by {flags})"))
+}
+
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {

@@ -154,7 +154,10 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
         split: split(args, ds)?,
         noise,
     };
-    DataSpec::resolve(&req, ds).context("--target, --window or --stride")
+    super::with_flags(
+        DataSpec::resolve(&req, ds),
+        "--target, --window or --stride",
+    )
 }
 
 /// The split flags resolved against the data set's seeds and conditions (the library's
@@ -168,9 +171,10 @@ pub fn split(args: &DataArgs, ds: &DataSet) -> Result<Split> {
         val_conditions: args.val_conditions.clone(),
         test_conditions: args.test_conditions.clone(),
     };
-    Ok(Split::resolve(&req, ds).context(
-        "--split, --train-seeds/--val-seeds/--test-seeds or --test-conditions/--val-conditions",
-    )?)
+    super::with_flags(
+        Split::resolve(&req, ds),
+        "--split, --test-conditions/--val-conditions or --train-seeds/--val-seeds/--test-seeds",
+    )
 }
 
 /// `ds` with `<channel>_noisy` copies of every channel of `channels` that lacks one, drawn
