@@ -383,7 +383,7 @@ impl<'a> Simulation<'a> {
         for e in &self.vehicle.elements {
             if let Element::TrackSpring(ts) = e {
                 let f = &self.frames[ts.body];
-                ts.apply(&self.states, &f.origin, &f.axes, &mut self.wrenches);
+                ts.restore(&self.states, &f.origin, &f.axes, &mut self.wrenches);
             }
         }
         self.contact()?;

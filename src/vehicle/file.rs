@@ -3,43 +3,49 @@
 //! tables are read here.
 
 use super::binder::Binder;
-use super::elements::{
-    CentrePlate, CentrePlateFile, CrossBracing, CrossBracingFile, LateralStop, LateralStopFile,
-    ShearPad, ShearPadFile, SideBearer, SideBearerFile, SpringNest, SpringNestFile, TrackSpring,
-    TrackSpringFile, WedgeDamper, WedgeDamperFile,
-};
+use super::elements::{ForceElement, for_each_element};
 use super::{Accelerometers, ContactSettings, Element, Hauling, SensorLayout, Vehicle};
 use crate::contact::{CreepLaw, Material, WheelsetGeometry, profile};
 use crate::error::{Error, Result};
 use serde::Deserialize;
 use std::path::Path;
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct VehicleFile {
-    name: Option<String>,
-    urdf: String,
-    contact: ContactFile,
-    #[serde(default)]
-    shear_pad: Vec<ShearPadFile>,
-    #[serde(default)]
-    spring_nest: Vec<SpringNestFile>,
-    #[serde(default)]
-    wedge_damper: Vec<WedgeDamperFile>,
-    #[serde(default)]
-    centre_plate: Vec<CentrePlateFile>,
-    #[serde(default)]
-    side_bearer: Vec<SideBearerFile>,
-    #[serde(default)]
-    cross_bracing: Vec<CrossBracingFile>,
-    #[serde(default)]
-    track_spring: Vec<TrackSpringFile>,
-    #[serde(default)]
-    lateral_stop: Vec<LateralStopFile>,
-    hauling: Option<HaulingFile>,
-    sensors: Option<SensorsFile>,
-    accelerometers: Option<String>,
+/// The vehicle file and the binding of its element tables, made from the one registration
+/// list of element kinds (`elements::for_each_element`): one array of tables per kind, bound in
+/// the list's order.
+macro_rules! define_vehicle_file {
+    ($($variant:ident $table:ident $doc:literal,)*) => {
+        #[derive(Debug, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct VehicleFile {
+            name: Option<String>,
+            urdf: String,
+            contact: ContactFile,
+            $(
+                #[serde(default)]
+                $table: Vec<<super::elements::$variant as ForceElement>::File>,
+            )*
+            hauling: Option<HaulingFile>,
+            sensors: Option<SensorsFile>,
+            accelerometers: Option<String>,
+        }
+
+        /// Binds every element table, kind by kind in registration order, each row named by
+        /// its table and index (`shear_pad[3]`).
+        fn bind_elements(raw: &VehicleFile, b: &Binder) -> Result<Vec<Element>> {
+            let mut elements = Vec::new();
+            $(
+                for (i, e) in raw.$table.iter().enumerate() {
+                    let field = format!("{}[{i}]", stringify!($table));
+                    let element = super::elements::$variant::bind(&field, e, b, &elements)?;
+                    elements.push(Element::$variant(element));
+                }
+            )*
+            Ok(elements)
+        }
+    };
 }
+for_each_element!(define_vehicle_file);
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -118,86 +124,7 @@ pub(super) fn load(path: &Path) -> Result<Vehicle> {
     let find = |field: String, name: &str| b.find(field, name);
     let non_negative = |field: String, values: &[f64]| b.non_negative(field, values);
     let positive = |field: String, v: f64| b.positive(field, v);
-    let mut elements = Vec::new();
-    for (i, e) in raw.shear_pad.iter().enumerate() {
-        elements.push(Element::ShearPad(ShearPad::bind(
-            &format!("shear_pad[{i}]"),
-            e,
-            &b,
-        )?));
-    }
-    let mut nests = Vec::new();
-    for (i, e) in raw.spring_nest.iter().enumerate() {
-        nests.push(elements.len());
-        elements.push(Element::SpringNest(SpringNest::bind(
-            &format!("spring_nest[{i}]"),
-            e,
-            &b,
-        )?));
-    }
-    let mut wedges = Vec::new();
-    for (i, e) in raw.wedge_damper.iter().enumerate() {
-        let f = format!("wedge_damper[{i}]");
-        // The nest between the same bodies presses this wedge.
-        let (u, l) = (
-            b.find(format!("{f}.upper"), &e.upper)?,
-            b.find(format!("{f}.lower"), &e.lower)?,
-        );
-        let nest = nests
-            .iter()
-            .find_map(|&k| match &elements[k] {
-                Element::SpringNest(n) if n.upper.body == u && n.lower.body == l => {
-                    Some((k, n.clone()))
-                }
-                _ => None,
-            })
-            .ok_or_else(|| {
-                b.err(
-                    f.clone(),
-                    format!(
-                        "no spring_nest between \"{}\" and \"{}\" to press the wedge",
-                        e.upper, e.lower
-                    ),
-                )
-            })?;
-        wedges.push((elements.len(), nest.0));
-        elements.push(Element::WedgeDamper(WedgeDamper::bind(&f, e, nest.1, &b)?));
-    }
-    for (i, e) in raw.centre_plate.iter().enumerate() {
-        elements.push(Element::CentrePlate(CentrePlate::bind(
-            &format!("centre_plate[{i}]"),
-            e,
-            &b,
-        )?));
-    }
-    for (i, e) in raw.side_bearer.iter().enumerate() {
-        elements.push(Element::SideBearer(SideBearer::bind(
-            &format!("side_bearer[{i}]"),
-            e,
-            &b,
-        )?));
-    }
-    for (i, e) in raw.lateral_stop.iter().enumerate() {
-        elements.push(Element::LateralStop(LateralStop::bind(
-            &format!("lateral_stop[{i}]"),
-            e,
-            &b,
-        )?));
-    }
-    for (i, e) in raw.cross_bracing.iter().enumerate() {
-        elements.push(Element::CrossBracing(CrossBracing::bind(
-            &format!("cross_bracing[{i}]"),
-            e,
-            &b,
-        )?));
-    }
-    for (i, e) in raw.track_spring.iter().enumerate() {
-        elements.push(Element::TrackSpring(TrackSpring::bind(
-            &format!("track_spring[{i}]"),
-            e,
-            &b,
-        )?));
-    }
+    let elements = bind_elements(&raw, &b)?;
 
     let c = &raw.contact;
     if c.wheelsets.is_empty() {
@@ -346,13 +273,10 @@ pub(super) fn load(path: &Path) -> Result<Vehicle> {
         accelerometers,
     };
     vehicle.distribute_static_load(path)?;
-    // Wedges read the nest's static compression.
-    for (w, n) in wedges {
-        if let Element::SpringNest(nest) = vehicle.elements[n].clone()
-            && let Element::WedgeDamper(wd) = &mut vehicle.elements[w]
-        {
-            wd.nest = nest;
-        }
+    // Elements that read others' static state (wedges, their nest's compression).
+    let settled = vehicle.elements.clone();
+    for e in &mut vehicle.elements {
+        e.settle(&settled);
     }
     Ok(vehicle)
 }

@@ -13,6 +13,7 @@ pub use wheel::{parse_wheel, wheel_name};
 
 pub use body::{Attachment, Body, BodyState, Wrench};
 pub use elements::Element;
+use elements::Support;
 
 use crate::contact::{CreepLaw, Material, WheelsetGeometry};
 use crate::error::{Error, Result};
@@ -221,11 +222,11 @@ impl Vehicle {
             let mut fixed = 0.0;
             let mut free: Vec<usize> = Vec::new();
             for (k, e) in self.elements.iter().enumerate() {
-                match e {
-                    Element::SideBearer(sb) if sb.upper.body == b => fixed += sb.preload,
-                    Element::ShearPad(x) if x.upper.body == b => free.push(k),
-                    Element::SpringNest(x) if x.upper.body == b => free.push(k),
-                    Element::CentrePlate(x) if x.upper.body == b => free.push(k),
+                match e.support() {
+                    Some(Support::Preloaded { upper, preload, .. }) if upper == b => {
+                        fixed += preload
+                    }
+                    Some(Support::Shared { upper, .. }) if upper.body == b => free.push(k),
                     _ => {}
                 }
             }
@@ -258,28 +259,21 @@ impl Vehicle {
                 ));
             }
             for &k in &free {
-                let lower = match &mut self.elements[k] {
-                    Element::ShearPad(x) => {
-                        x.preload = share;
-                        x.lower.body
-                    }
-                    Element::SpringNest(x) => {
-                        x.static_compression = x.law.compression(share);
-                        x.lower.body
-                    }
-                    Element::CentrePlate(x) => {
-                        x.preload = share;
-                        x.lower.body
-                    }
-                    _ => unreachable!(),
+                let Some(Support::Shared { lower, .. }) = self.elements[k].support() else {
+                    unreachable!("a free support is shared")
                 };
+                self.elements[k].take_share(share);
                 carried[lower] += share;
             }
             for e in &self.elements {
-                if let Element::SideBearer(sb) = e
-                    && sb.upper.body == b
+                if let Some(Support::Preloaded {
+                    upper,
+                    lower,
+                    preload,
+                }) = e.support()
+                    && upper == b
                 {
-                    carried[sb.lower.body] += sb.preload;
+                    carried[lower] += preload;
                 }
             }
         }
@@ -287,12 +281,9 @@ impl Vehicle {
     }
 
     fn support_point(&self, k: usize) -> Vector3<f64> {
-        let a = match &self.elements[k] {
-            Element::ShearPad(x) => x.upper,
-            Element::SpringNest(x) => x.upper,
-            Element::CentrePlate(x) => x.upper,
-            _ => unreachable!(),
+        let Some(Support::Shared { upper, .. }) = self.elements[k].support() else {
+            unreachable!("a free support is shared")
         };
-        self.bodies[a.body].position + a.local
+        self.bodies[upper.body].position + upper.local
     }
 }

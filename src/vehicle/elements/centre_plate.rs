@@ -8,7 +8,7 @@
 //! the plate lifts at its edge. Without it a bolster loaded through a point above its centre of
 //! gravity and supported below it is an inverted pendulum.
 
-use super::{Memory, Relative, slider};
+use super::{Element, ForceElement, Memory, Relative, Support, slider};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
@@ -47,7 +47,7 @@ impl CentrePlate {
         self.friction * normal * (2.0 / 3.0) * self.radius
     }
 
-    pub(crate) fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
         let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         let mut f = self.stiffness.component_mul(&r.d) + self.damping.component_mul(&r.v);
         f.z += self.preload;
@@ -117,7 +117,7 @@ pub(crate) struct CentrePlateFile {
 }
 
 impl CentrePlate {
-    pub(crate) fn bind(f: &str, e: &CentrePlateFile, b: &Binder) -> Result<Self> {
+    fn from_row(f: &str, e: &CentrePlateFile, b: &Binder) -> Result<Self> {
         b.non_negative(format!("{f}.stiffness"), &e.stiffness)?;
         b.non_negative(format!("{f}.damping"), &e.damping)?;
         b.non_negative(format!("{f}.friction"), &[e.friction])?;
@@ -134,5 +134,35 @@ impl CentrePlate {
             radius: e.radius_m,
             preload: 0.0,
         })
+    }
+}
+
+impl ForceElement for CentrePlate {
+    const TABLE: &'static str = "centre_plate";
+    type File = CentrePlateFile;
+    fn bind(f: &str, e: &CentrePlateFile, b: &Binder, _: &[Element]) -> Result<Self> {
+        Self::from_row(f, e, b)
+    }
+    #[inline]
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+        self.forces(states, memory, wrenches)
+    }
+    fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
+        Some((&self.upper, &self.lower, &self.rest))
+    }
+    fn gauge_stem(&self, _: &str, lower: &str, _: &str) -> Option<String> {
+        Some(format!("centreplate_{lower}"))
+    }
+    fn gauge_axes(&self) -> &'static [usize] {
+        &[2]
+    }
+    fn support(&self) -> Option<Support> {
+        Some(Support::Shared {
+            upper: self.upper,
+            lower: self.lower.body,
+        })
+    }
+    fn take_share(&mut self, share: f64) {
+        self.preload = share;
     }
 }

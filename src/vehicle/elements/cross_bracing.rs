@@ -4,6 +4,7 @@
 //! axes of their mean yaw; energy `½·k·γ²`, applied as the matching pair of longitudinal forces
 //! and yaw torques (no net force, no net moment).
 
+use super::{Element, ForceElement, Memory};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{BodyState, Wrench};
@@ -45,7 +46,7 @@ impl CrossBracing {
         (dx.atan2(dy), dy, Vector3::new(c, s, 0.0))
     }
 
-    pub(crate) fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
         let (gamma, dy, ex) = self.geometry(states);
         let m = self.warp_stiffness * gamma;
         let f = ex * (m / dy.abs().max(1e-3));
@@ -66,12 +67,24 @@ pub(crate) struct CrossBracingFile {
 }
 
 impl CrossBracing {
-    pub(crate) fn bind(f: &str, e: &CrossBracingFile, b: &Binder) -> Result<Self> {
+    fn from_row(f: &str, e: &CrossBracingFile, b: &Binder) -> Result<Self> {
         b.non_negative(format!("{f}.warp_stiffness"), &[e.warp_stiffness])?;
         Ok(CrossBracing {
             left: b.find(format!("{f}.left"), &e.left)?,
             right: b.find(format!("{f}.right"), &e.right)?,
             warp_stiffness: e.warp_stiffness,
         })
+    }
+}
+
+impl ForceElement for CrossBracing {
+    const TABLE: &'static str = "cross_bracing";
+    type File = CrossBracingFile;
+    fn bind(f: &str, e: &CrossBracingFile, b: &Binder, _: &[Element]) -> Result<Self> {
+        Self::from_row(f, e, b)
+    }
+    #[inline]
+    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench]) {
+        self.forces(states, wrenches)
     }
 }

@@ -2,7 +2,7 @@
 //! columns): no force within ±`clearance` of the static position, beyond it a stiff spring
 //! `k·(|d_y| − c)` pushing back, with damping only while in contact.
 
-use super::Relative;
+use super::{Element, ForceElement, Memory, Relative};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
@@ -40,7 +40,7 @@ impl LateralStop {
         d.signum() * f.max(0.0)
     }
 
-    pub(crate) fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
         let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         let fy = self.force(r.d.y, r.v.y);
         if fy != 0.0 {
@@ -74,7 +74,7 @@ pub(crate) struct LateralStopFile {
 }
 
 impl LateralStop {
-    pub(crate) fn bind(f: &str, e: &LateralStopFile, b: &Binder) -> Result<Self> {
+    fn from_row(f: &str, e: &LateralStopFile, b: &Binder) -> Result<Self> {
         b.non_negative(format!("{f}.clearance_m"), &[e.clearance_m])?;
         b.positive(format!("{f}.stiffness"), e.stiffness)?;
         b.non_negative(format!("{f}.damping"), &[e.damping])?;
@@ -88,5 +88,17 @@ impl LateralStop {
             stiffness: e.stiffness,
             damping: e.damping,
         })
+    }
+}
+
+impl ForceElement for LateralStop {
+    const TABLE: &'static str = "lateral_stop";
+    type File = LateralStopFile;
+    fn bind(f: &str, e: &LateralStopFile, b: &Binder, _: &[Element]) -> Result<Self> {
+        Self::from_row(f, e, b)
+    }
+    #[inline]
+    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench]) {
+        self.forces(states, wrenches)
     }
 }

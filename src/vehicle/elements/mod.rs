@@ -29,74 +29,180 @@ pub use spring_nest::{NestLaw, SpringNest};
 pub use track_spring::TrackSpring;
 pub use wedge_damper::{WedgeDamper, slider};
 
-pub(crate) use centre_plate::CentrePlateFile;
-pub(crate) use cross_bracing::CrossBracingFile;
-pub(crate) use lateral_stop::LateralStopFile;
-pub(crate) use shear_pad::ShearPadFile;
-pub(crate) use side_bearer::SideBearerFile;
-pub(crate) use spring_nest::SpringNestFile;
-pub(crate) use track_spring::TrackSpringFile;
-pub(crate) use wedge_damper::WedgeDamperFile;
-
 /// Internal state of an element that has one (the friction sliders of wedges, centre plates and
 /// side bearers), zero at the static position; the simulation keeps one per element.
 pub type Memory = [f64; 4];
 
+use super::binder::Binder;
 use super::body::{Attachment, BodyState, Wrench};
+use crate::error::Result;
 use nalgebra::{Matrix3, Vector3};
 
-/// Any force element.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Element {
-    /// Axle-box rubber shear pad (side frame ↔ wheelset).
-    ShearPad(ShearPad),
-    /// Two-stage spring nest (bolster ↔ side frame).
-    SpringNest(SpringNest),
-    /// Wedge friction damper (bolster ↔ side frame).
-    WedgeDamper(WedgeDamper),
-    /// Centre plate (carbody ↔ bolster).
-    CentrePlate(CentrePlate),
-    /// Constant-contact side bearer (carbody ↔ bolster).
-    SideBearer(SideBearer),
-    /// Cross-bracing between the two side frames of a bogie.
-    CrossBracing(CrossBracing),
-    /// Lateral stop with clearance (bolster gibs ↔ side frame).
-    LateralStop(LateralStop),
-    /// Lateral and yaw spring to the track (Wickens' restrained wheelset).
-    TrackSpring(TrackSpring),
+/// The registration of every force element kind, in the order a vehicle file's tables are
+/// bound (and the simulation adds their forces): variant, table name in the vehicle file, and
+/// what it is. **A new kind is its file (the element, its table, its `impl ForceElement`) plus
+/// one line here** (and its `mod` and `pub use` above). The enum [`Element`], its dispatch and
+/// the vehicle file's element tables are all made from this list.
+macro_rules! for_each_element {
+    ($then:ident) => {
+        $then! {
+            ShearPad shear_pad "Axle-box rubber shear pad (side frame ↔ wheelset).",
+            SpringNest spring_nest "Two-stage spring nest (bolster ↔ side frame).",
+            WedgeDamper wedge_damper "Wedge friction damper (bolster ↔ side frame).",
+            CentrePlate centre_plate "Centre plate (carbody ↔ bolster).",
+            SideBearer side_bearer "Constant-contact side bearer (carbody ↔ bolster).",
+            LateralStop lateral_stop "Lateral stop with clearance (bolster gibs ↔ side frame).",
+            CrossBracing cross_bracing "Cross-bracing between the two side frames of a bogie.",
+            TrackSpring track_spring "Lateral and yaw spring to the track (Wickens' restrained wheelset).",
+        }
+    };
+}
+pub(crate) use for_each_element;
+
+/// How an element carries its upper body's weight in the static load path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Support {
+    /// Carries a share of the load, equal among the body's supports, set by the load path.
+    Shared {
+        /// Where it meets the upper body.
+        upper: Attachment,
+        /// The body below.
+        lower: usize,
+    },
+    /// Carries its own given preload (a side bearer's).
+    Preloaded {
+        /// The body above.
+        upper: usize,
+        /// The body below.
+        lower: usize,
+        /// Its preload, N.
+        preload: f64,
+    },
 }
 
-impl Element {
-    /// Adds this element's forces to the wrenches of the bodies it connects, updating its
-    /// internal state (`memory`, used by elements with sliders).
-    #[inline]
-    pub fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
-        match self {
-            Element::ShearPad(e) => e.apply(states, wrenches),
-            Element::SpringNest(e) => e.apply(states, wrenches),
-            Element::WedgeDamper(e) => e.apply(states, memory, wrenches),
-            Element::LateralStop(e) => e.apply(states, wrenches),
-            Element::CentrePlate(e) => e.apply(states, memory, wrenches),
-            Element::SideBearer(e) => e.apply(states, memory, wrenches),
-            Element::CrossBracing(e) => e.apply(states, wrenches),
-            // Needs the track frame: applied by the simulation (see `Simulation::step`).
-            Element::TrackSpring(_) => {}
-        }
+/// What every force element kind provides: its vehicle-file table, how a row of it is bound
+/// (checked, named by file and field), its force law, and its part in the gauges and the
+/// static load path. Implemented in each element's own file.
+pub(crate) trait ForceElement: Sized {
+    /// The element's table in the vehicle file (`[[shear_pad]]`).
+    const TABLE: &'static str;
+    /// One row of that table as the file writes it.
+    type File: serde::de::DeserializeOwned;
+    /// Binds row `file` (field path `field`, e.g. `shear_pad[3]`); `bound` holds the elements
+    /// bound before it (a wedge finds the nest that presses it).
+    fn bind(field: &str, file: &Self::File, b: &Binder, bound: &[Element]) -> Result<Self>;
+    /// Adds the element's forces to the wrenches of its bodies.
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]);
+    /// Where it meets its two bodies and their static offset (kinds with gauges or supports).
+    fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
+        None
     }
+    /// Relative displacement across it from the static loaded position (upper body's axes).
+    fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
+        let (upper, lower, rest) = self.attachments()?;
+        Some(Relative::new(upper, lower, rest, states).d)
+    }
+    /// Stem of its gauge channels from its bodies' names and its side (`l`/`r`).
+    fn gauge_stem(&self, _upper: &str, _lower: &str, _side: &str) -> Option<String> {
+        None
+    }
+    /// The deflection axes its gauges record (0 x, 1 y, 2 z), in order.
+    fn gauge_axes(&self) -> &'static [usize] {
+        &[]
+    }
+    /// Its part in the static load path.
+    fn support(&self) -> Option<Support> {
+        None
+    }
+    /// Takes its share of the static load, N (for [`Support::Shared`]).
+    fn take_share(&mut self, _share: f64) {}
+    /// Once every static load is set: reads what other elements settled to (a wedge, its
+    /// nest's static compression).
+    fn settle(&mut self, _elements: &[Element]) {}
+}
 
-    /// Relative displacement across the element from its static loaded position, in the upper
-    /// body's axes (lower attachment relative to the upper: `+z` compresses a supporting
-    /// element), for the kinds that carry a displacement gauge (assets/docs/physics.md §5).
-    pub fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
-        match self {
-            Element::ShearPad(e) => Some(e.relative(states).d),
-            _ => {
-                let (upper, lower, rest) = self.attachments()?;
-                Some(Relative::new(upper, lower, rest, states).d)
+macro_rules! define_element {
+    ($($variant:ident $table:ident $doc:literal,)*) => {
+        /// Any force element.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum Element {
+            $(#[doc = $doc] $variant($variant),)*
+        }
+
+        impl Element {
+            /// Adds this element's forces to the wrenches of the bodies it connects, updating its
+            /// internal state (`memory`, used by elements with sliders).
+            #[inline]
+            pub fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+                match self {
+                    $(Element::$variant(e) => e.apply(states, memory, wrenches),)*
+                }
+            }
+
+            /// Relative displacement across the element from its static loaded position, in the
+            /// upper body's axes (lower attachment relative to the upper: `+z` compresses a
+            /// supporting element), for the kinds that carry a displacement gauge
+            /// (assets/docs/physics.md §5).
+            pub fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
+                match self {
+                    $(Element::$variant(e) => e.deflection(states),)*
+                }
+            }
+
+            /// The axes (0 x, 1 y, 2 z) of the deflection that [`Element::gauges`] records, in
+            /// its order; empty for elements without gauges. Allocation-free: the recorder calls
+            /// it at every step.
+            pub fn gauge_axes(&self) -> &'static [usize] {
+                match self {
+                    $(Element::$variant(e) => e.gauge_axes(),)*
+                }
+            }
+
+            fn gauge_stem(&self, upper: &str, lower: &str, side: &str) -> Option<String> {
+                match self {
+                    $(Element::$variant(e) => e.gauge_stem(upper, lower, side),)*
+                }
+            }
+
+            fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
+                match self {
+                    $(Element::$variant(e) => e.attachments(),)*
+                }
+            }
+
+            /// Its part in the static load path.
+            pub(crate) fn support(&self) -> Option<Support> {
+                match self {
+                    $(Element::$variant(e) => e.support(),)*
+                }
+            }
+
+            /// Takes its share of the static load, N.
+            pub(crate) fn take_share(&mut self, share: f64) {
+                match self {
+                    $(Element::$variant(e) => e.take_share(share),)*
+                }
+            }
+
+            /// Reads what the other elements settled to, once every static load is set.
+            pub(crate) fn settle(&mut self, elements: &[Element]) {
+                match self {
+                    $(Element::$variant(e) => e.settle(elements),)*
+                }
+            }
+
+            /// Kind name as in the vehicle file.
+            pub fn kind(&self) -> &'static str {
+                match self {
+                    $(Element::$variant(_) => <$variant as ForceElement>::TABLE,)*
+                }
             }
         }
-    }
+    };
+}
+for_each_element!(define_element);
 
+impl Element {
     /// The displacement gauges across this element: channel name and axis (0 x, 1 y, 2 z) of
     /// [`Element::deflection`]. Spring nests read vertical and lateral (`nest_<side frame>_z`,
     /// `_y`), shear pads x, y, z (`pad_<side frame>_<wheelset>_x` …), side bearers vertical
@@ -108,53 +214,13 @@ impl Element {
         };
         let (u, l) = (&bodies[upper.body].name, &bodies[lower.body].name);
         let side = if lower.local.y > 1e-3 { "l" } else { "r" };
-        let stem = match self {
-            Element::SpringNest(_) => format!("nest_{l}"),
-            Element::ShearPad(_) => format!("pad_{u}_{l}"),
-            Element::SideBearer(_) => format!("sidebearer_{l}_{side}"),
-            Element::CentrePlate(_) => format!("centreplate_{l}"),
-            _ => return Vec::new(),
+        let Some(stem) = self.gauge_stem(u, l, side) else {
+            return Vec::new();
         };
         self.gauge_axes()
             .iter()
             .map(|&a| (format!("{stem}_{}", ["x", "y", "z"][a]), a))
             .collect()
-    }
-
-    /// The axes (0 x, 1 y, 2 z) of the deflection that [`Element::gauges`] records, in its
-    /// order; empty for elements without gauges. Allocation-free: the recorder calls it at
-    /// every step.
-    pub fn gauge_axes(&self) -> &'static [usize] {
-        match self {
-            Element::SpringNest(_) => &[2, 1],
-            Element::ShearPad(_) => &[0, 1, 2],
-            Element::SideBearer(_) | Element::CentrePlate(_) => &[2],
-            _ => &[],
-        }
-    }
-
-    fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
-        match self {
-            Element::ShearPad(e) => Some((&e.upper, &e.lower, &e.rest)),
-            Element::SpringNest(e) => Some((&e.upper, &e.lower, &e.rest)),
-            Element::CentrePlate(e) => Some((&e.upper, &e.lower, &e.rest)),
-            Element::SideBearer(e) => Some((&e.upper, &e.lower, &e.rest)),
-            _ => None,
-        }
-    }
-
-    /// Kind name as in the vehicle file.
-    pub fn kind(&self) -> &'static str {
-        match self {
-            Element::ShearPad(_) => "shear_pad",
-            Element::SpringNest(_) => "spring_nest",
-            Element::WedgeDamper(_) => "wedge_damper",
-            Element::CentrePlate(_) => "centre_plate",
-            Element::SideBearer(_) => "side_bearer",
-            Element::CrossBracing(_) => "cross_bracing",
-            Element::LateralStop(_) => "lateral_stop",
-            Element::TrackSpring(_) => "track_spring",
-        }
     }
 }
 

@@ -15,7 +15,7 @@
 //! direction, and the side frame's vertical square to it), and the pad's moment about the
 //! axle's axis goes to the side frame through the jaws, never spinning the wheelset.
 
-use super::Relative;
+use super::{Element, ForceElement, Memory, Relative, Support};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
@@ -75,7 +75,7 @@ impl ShearPad {
         }
     }
 
-    pub(crate) fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
         let r = self.relative(states);
         let f = self.stiffness.component_mul(&r.d)
             + self.damping.component_mul(&r.v)
@@ -141,7 +141,7 @@ pub(crate) struct ShearPadFile {
 }
 
 impl ShearPad {
-    pub(crate) fn bind(f: &str, e: &ShearPadFile, b: &Binder) -> Result<Self> {
+    fn from_row(f: &str, e: &ShearPadFile, b: &Binder) -> Result<Self> {
         b.non_negative(format!("{f}.stiffness"), &e.stiffness)?;
         b.non_negative(format!("{f}.damping"), &e.damping)?;
         b.non_negative(format!("{f}.width_m"), &[e.width_m])?;
@@ -156,5 +156,38 @@ impl ShearPad {
             preload: 0.0,
             width: e.width_m,
         })
+    }
+}
+
+impl ForceElement for ShearPad {
+    const TABLE: &'static str = "shear_pad";
+    type File = ShearPadFile;
+    fn bind(f: &str, e: &ShearPadFile, b: &Binder, _: &[Element]) -> Result<Self> {
+        Self::from_row(f, e, b)
+    }
+    #[inline]
+    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench]) {
+        self.forces(states, wrenches)
+    }
+    fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
+        Some((&self.upper, &self.lower, &self.rest))
+    }
+    fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
+        Some(self.relative(states).d)
+    }
+    fn gauge_stem(&self, upper: &str, lower: &str, _: &str) -> Option<String> {
+        Some(format!("pad_{upper}_{lower}"))
+    }
+    fn gauge_axes(&self) -> &'static [usize] {
+        &[0, 1, 2]
+    }
+    fn support(&self) -> Option<Support> {
+        Some(Support::Shared {
+            upper: self.upper,
+            lower: self.lower.body,
+        })
+    }
+    fn take_share(&mut self, share: f64) {
+        self.preload = share;
     }
 }

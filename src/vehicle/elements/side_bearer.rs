@@ -5,7 +5,7 @@
 //! compression beyond the static position the cage bottoms out and the much stiffer stop
 //! (bolster and carbody bolster in series) carries the rest.
 
-use super::{Memory, Relative, slider};
+use super::{Element, ForceElement, Memory, Relative, Support, slider};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
@@ -46,7 +46,7 @@ impl SideBearer {
             .max(0.0)
     }
 
-    pub(crate) fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
         let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         let normal = (self.vertical_force(r.d.z) + self.damping * r.v.z).max(0.0);
         let mut s = Vector2::new(memory[0], memory[1]);
@@ -97,7 +97,7 @@ fn default_stop_stiffness() -> f64 {
 }
 
 impl SideBearer {
-    pub(crate) fn bind(f: &str, e: &SideBearerFile, b: &Binder) -> Result<Self> {
+    fn from_row(f: &str, e: &SideBearerFile, b: &Binder) -> Result<Self> {
         b.non_negative(
             format!("{f}.stiffness"),
             &[e.stiffness, e.preload_n, e.friction],
@@ -122,6 +122,34 @@ impl SideBearer {
             damping: e.damping,
             travel,
             stop_stiffness: e.stop_stiffness,
+        })
+    }
+}
+
+impl ForceElement for SideBearer {
+    const TABLE: &'static str = "side_bearer";
+    type File = SideBearerFile;
+    fn bind(f: &str, e: &SideBearerFile, b: &Binder, _: &[Element]) -> Result<Self> {
+        Self::from_row(f, e, b)
+    }
+    #[inline]
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+        self.forces(states, memory, wrenches)
+    }
+    fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
+        Some((&self.upper, &self.lower, &self.rest))
+    }
+    fn gauge_stem(&self, _: &str, lower: &str, side: &str) -> Option<String> {
+        Some(format!("sidebearer_{lower}_{side}"))
+    }
+    fn gauge_axes(&self) -> &'static [usize] {
+        &[2]
+    }
+    fn support(&self) -> Option<Support> {
+        Some(Support::Preloaded {
+            upper: self.upper.body,
+            lower: self.lower.body,
+            preload: self.preload,
         })
     }
 }

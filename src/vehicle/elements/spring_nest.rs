@@ -9,7 +9,7 @@
 //! `k·l²` per axis with the current tangent stiffness k, up to the moment `F·l` at which the
 //! springs on one side unload.
 
-use super::Relative;
+use super::{Element, ForceElement, Memory, Relative, Support};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
@@ -103,7 +103,7 @@ pub struct SpringNest {
 }
 
 impl SpringNest {
-    pub(crate) fn apply(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
         let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         let c = self.static_compression + r.d.z;
         let fz = self.law.force(c);
@@ -150,7 +150,7 @@ pub(crate) struct SpringNestFile {
 }
 
 impl SpringNest {
-    pub(crate) fn bind(f: &str, e: &SpringNestFile, b: &Binder) -> Result<Self> {
+    fn from_row(f: &str, e: &SpringNestFile, b: &Binder) -> Result<Self> {
         b.positive(format!("{f}.outer_stiffness"), e.outer_stiffness)?;
         b.non_negative(format!("{f}.inner_stiffness"), &[e.inner_stiffness])?;
         b.non_negative(format!("{f}.inner_gap_m"), &[e.inner_gap_m])?;
@@ -177,5 +177,35 @@ impl SpringNest {
             static_compression: 0.0,
             footprint: e.footprint_m,
         })
+    }
+}
+
+impl ForceElement for SpringNest {
+    const TABLE: &'static str = "spring_nest";
+    type File = SpringNestFile;
+    fn bind(f: &str, e: &SpringNestFile, b: &Binder, _: &[Element]) -> Result<Self> {
+        Self::from_row(f, e, b)
+    }
+    #[inline]
+    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench]) {
+        self.forces(states, wrenches)
+    }
+    fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
+        Some((&self.upper, &self.lower, &self.rest))
+    }
+    fn gauge_stem(&self, _: &str, lower: &str, _: &str) -> Option<String> {
+        Some(format!("nest_{lower}"))
+    }
+    fn gauge_axes(&self) -> &'static [usize] {
+        &[2, 1]
+    }
+    fn support(&self) -> Option<Support> {
+        Some(Support::Shared {
+            upper: self.upper,
+            lower: self.lower.body,
+        })
+    }
+    fn take_share(&mut self, share: f64) {
+        self.static_compression = self.law.compression(share);
     }
 }

@@ -2,6 +2,7 @@
 //! frame, as used by Wickens' single restrained wheelset (a wheelset held by springs to a
 //! frame that runs exactly along the track). Not part of a real wagon.
 
+use super::{Element, ForceElement, Memory};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{BodyState, Wrench};
@@ -22,7 +23,7 @@ pub struct TrackSpring {
 impl TrackSpring {
     /// Adds the restoring force and torque; `origin` and `axes` are the track frame at the
     /// body.
-    pub(crate) fn apply(
+    pub(crate) fn restore(
         &self,
         states: &[BodyState],
         origin: &nalgebra::Vector3<f64>,
@@ -50,7 +51,7 @@ pub(crate) struct TrackSpringFile {
 }
 
 impl TrackSpring {
-    pub(crate) fn bind(f: &str, e: &TrackSpringFile, b: &Binder) -> Result<Self> {
+    fn from_row(f: &str, e: &TrackSpringFile, b: &Binder) -> Result<Self> {
         b.non_negative(
             format!("{f}.lateral_stiffness"),
             &[e.lateral_stiffness, e.yaw_stiffness],
@@ -61,4 +62,14 @@ impl TrackSpring {
             yaw_stiffness: e.yaw_stiffness,
         })
     }
+}
+
+impl ForceElement for TrackSpring {
+    const TABLE: &'static str = "track_spring";
+    type File = TrackSpringFile;
+    fn bind(f: &str, e: &TrackSpringFile, b: &Binder, _: &[Element]) -> Result<Self> {
+        Self::from_row(f, e, b)
+    }
+    /// Needs the track frame: the simulation applies it ([`TrackSpring::restore`]).
+    fn apply(&self, _: &[BodyState], _: &mut Memory, _: &mut [Wrench]) {}
 }

@@ -14,7 +14,7 @@
 //! - Warp (relative yaw ψ of side frame and bolster): the wedges' pressure moves across their
 //!   faces, a moment `k_ψ·(ψ − ψ_s)` that slips at `warp_ratio·N` (N·m per N of nest force).
 
-use super::{Memory, Relative};
+use super::{Element, ForceElement, Memory, Relative};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
 use crate::vehicle::body::{Attachment, BodyState, Wrench};
@@ -89,7 +89,7 @@ impl WedgeDamper {
         )
     }
 
-    pub(crate) fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
         let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         // The nest's own compression (its points are not the wedge's) sets the control springs.
         let n = &self.nest;
@@ -160,12 +160,7 @@ pub(crate) struct WedgeDamperFile {
 
 impl WedgeDamper {
     /// Binds the file's table; `nest` is the spring nest between the same two bodies.
-    pub(crate) fn bind(
-        f: &str,
-        e: &WedgeDamperFile,
-        nest: super::SpringNest,
-        b: &Binder,
-    ) -> Result<Self> {
+    fn from_row(f: &str, e: &WedgeDamperFile, nest: super::SpringNest, b: &Binder) -> Result<Self> {
         b.non_negative(format!("{f}.friction"), &[e.friction])?;
         if !(e.wedge_angle_deg > 5.0 && e.wedge_angle_deg < 85.0) {
             return Err(b.err(
@@ -207,4 +202,44 @@ impl WedgeDamper {
             nest,
         })
     }
+}
+
+impl ForceElement for WedgeDamper {
+    const TABLE: &'static str = "wedge_damper";
+    type File = WedgeDamperFile;
+    /// The nest between the same two bodies, bound before it, presses the wedge.
+    fn bind(f: &str, e: &WedgeDamperFile, b: &Binder, bound: &[Element]) -> Result<Self> {
+        let (u, l) = (
+            b.find(format!("{f}.upper"), &e.upper)?,
+            b.find(format!("{f}.lower"), &e.lower)?,
+        );
+        let nest = nest_between(bound, u, l).ok_or_else(|| {
+            b.err(
+                f.to_string(),
+                format!(
+                    "no spring_nest between \"{}\" and \"{}\" to press the wedge",
+                    e.upper, e.lower
+                ),
+            )
+        })?;
+        Self::from_row(f, e, nest.clone(), b)
+    }
+    #[inline]
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+        self.forces(states, memory, wrenches)
+    }
+    /// Reads its nest's static compression once the load path has set it.
+    fn settle(&mut self, elements: &[Element]) {
+        if let Some(nest) = nest_between(elements, self.nest.upper.body, self.nest.lower.body) {
+            self.nest = nest.clone();
+        }
+    }
+}
+
+/// The first spring nest between bodies `upper` and `lower`.
+fn nest_between(elements: &[Element], upper: usize, lower: usize) -> Option<&super::SpringNest> {
+    elements.iter().find_map(|e| match e {
+        Element::SpringNest(n) if n.upper.body == upper && n.lower.body == lower => Some(n),
+        _ => None,
+    })
 }
