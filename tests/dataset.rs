@@ -1,6 +1,6 @@
 //! Data set generation: formats, resume, shards, noise, and loading from Python.
 
-mod common;
+use crate::common;
 
 use railforce::dataset::{self, Event, Format, GenerateOptions, Manifest, npz};
 use railforce::plan::Plan;

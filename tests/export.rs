@@ -2,7 +2,7 @@
 //! alone (assets/python/numpy_forward.py, PyTorch's names and layouts), gives the forces
 //! `railforce identify` gives.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -2,7 +2,7 @@
 //! evaluation (continuous, and the same in a run and in `railforce contact`), and (ignored,
 //! release) the simulator's fidelity checks.
 
-mod common;
+use crate::common;
 
 use railforce::contact::{Side, WheelOnRail, evaluate, height_for_load};
 use railforce::sim::{SimConfig, Simulation, fidelity};

@@ -4,7 +4,7 @@
 //! a value or an error that names the file; a panic fails the test. A bounded number of cases
 //! per file (seeded, so a failure reproduces).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! RAILFORCE_PYTHON_TESTS=1 and scikit-learn installed): SVR, GBDT and the decision tree must
 //! score within 0.03 test R² of scikit-learn's with the same settings.
 
-mod common;
+use crate::common;
 
 use railforce::learn::classical::{Classical, ClassicalParams};
 use rand::RngExt;

@@ -1,7 +1,7 @@
 //! The viewer: the scene a page draws, the page itself, and (release, CI) the page in a real
 //! browser.
 
-mod common;
+use crate::common;
 
 use railforce::sim::{SimConfig, Simulation, output};
 use railforce::track::{Track, TrackSpec};

@@ -1,0 +1,42 @@
+//! The integration tests, one binary (as ripgrep does): each file of `tests/` is a module
+//! here, so the library is linked once instead of once per file. Run one file's tests with a
+//! filter: `cargo test --test all -- dataset::` (or several: `-- neural:: learn::`).
+
+#[path = "common/mod.rs"]
+mod common;
+#[path = "assess.rs"]
+mod assess;
+#[path = "bogie.rs"]
+mod bogie;
+#[path = "cli.rs"]
+mod cli;
+#[path = "contact.rs"]
+mod contact;
+#[path = "dataset.rs"]
+mod dataset;
+#[path = "dynamics.rs"]
+mod dynamics;
+#[path = "experiment.rs"]
+mod experiment;
+#[path = "export.rs"]
+mod export;
+#[path = "features.rs"]
+mod features;
+#[path = "fidelity.rs"]
+mod fidelity;
+#[path = "identify.rs"]
+mod identify;
+#[path = "learn.rs"]
+mod learn;
+#[path = "mutation.rs"]
+mod mutation;
+#[path = "neural.rs"]
+mod neural;
+#[path = "sensors.rs"]
+mod sensors;
+#[path = "sklearn.rs"]
+mod sklearn;
+#[path = "track.rs"]
+mod track;
+#[path = "view.rs"]
+mod view;
