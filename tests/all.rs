@@ -2,14 +2,14 @@
 //! here, so the library is linked once instead of once per file. Run one file's tests with a
 //! filter: `cargo test --test all -- dataset::` (or several: `-- neural:: learn::`).
 
-#[path = "common/mod.rs"]
-mod common;
 #[path = "assess.rs"]
 mod assess;
 #[path = "bogie.rs"]
 mod bogie;
 #[path = "cli.rs"]
 mod cli;
+#[path = "common/mod.rs"]
+mod common;
 #[path = "contact.rs"]
 mod contact;
 #[path = "dataset.rs"]
