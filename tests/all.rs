@@ -36,6 +36,8 @@ mod neural;
 mod sensors;
 #[path = "sklearn.rs"]
 mod sklearn;
+#[path = "stability.rs"]
+mod stability;
 #[path = "track.rs"]
 mod track;
 #[path = "view.rs"]

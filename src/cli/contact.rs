@@ -131,7 +131,7 @@ fn state(args: &ContactArgs, y: f64, yaw: f64) -> WheelsetState {
 }
 
 /// Parses `FROM:TO:STEP`.
-fn range(text: &str, what: &str) -> Result<Vec<f64>> {
+pub(super) fn range(text: &str, what: &str) -> Result<Vec<f64>> {
     let parts: Vec<f64> = text
         .split(':')
         .map(|p| p.trim().parse::<f64>())

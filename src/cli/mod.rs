@@ -9,6 +9,7 @@ mod experiment;
 mod export;
 mod generate;
 mod identify;
+mod modes;
 mod select;
 mod simulate;
 mod track;
@@ -55,6 +56,20 @@ enum Command {
         after_help = "Examples:\n  railforce contact --vehicle c80 --y-mm 6 --yaw-mrad 2\n  railforce contact --vehicle c80 --sweep-y -10:10:0.5 --out sweep.csv"
     )]
     Contact(contact::ContactArgs),
+    /// Linear stability against speed: the whole model linearised about its centred
+    /// equilibrium on smooth tangent track, eigenvalues (root locus), damping, named modes
+    /// and each family's linear critical speed.
+    ///
+    /// The linearisation calls the run's own force evaluation (elements, contact, rails,
+    /// hauling) and differentiates it numerically; the contact enters at an amplitude (its
+    /// secant over ± --amplitude-mm: the equivalent conicity with the contact-angle and
+    /// gravitational terms) with linear Kalker creep; friction elements stuck and sliding give
+    /// two loci. Modes are named by where their kinetic energy lies (wheelset hunting, bogie
+    /// hunting, carbody lower and upper sway, yaw …).
+    #[command(
+        after_help = "Examples:\n  railforce modes --vehicle c80 --speeds 20:200:10 --out modes_c80\n  railforce modes --vehicle c80_empty --flange-back-change-mm 7 --friction stuck --out modes_empty_1360"
+    )]
+    Modes(modes::ModesArgs),
     /// Simulate a vehicle on a track and record the 21 sensor channels, the forces of every
     /// wheel and the motion of every body at 200 Hz.
     ///
@@ -216,6 +231,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Track(args) => track::run(args),
         Command::Contact(args) => contact::run(args),
+        Command::Modes(args) => modes::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Select(args) => select::run(args),

@@ -19,7 +19,8 @@ pub struct StaticCheck {
     pub sum_ratio: f64,
 }
 
-fn smooth_tangent(length: f64) -> Track {
+/// A smooth level tangent of `length` metres on rigid rails (the closed forms' track).
+pub fn smooth_tangent(length: f64) -> Track {
     let text = format!(
         "name = \"smooth tangent\"\n[[section]]\nkind = \"tangent\"\nlength_m = {length}\n"
     );

@@ -15,6 +15,7 @@
 pub mod checks;
 pub mod fidelity;
 pub mod filter;
+pub mod modes;
 pub mod output;
 mod track_frame;
 mod wheel_rail;
@@ -361,34 +362,8 @@ impl<'a> Simulation<'a> {
     /// Advances one integration step.
     pub fn step(&mut self) -> Result<()> {
         let dt = self.cfg.dt;
-        let g = crate::GRAVITY;
-        for (w, (b, s)) in self
-            .wrenches
-            .iter_mut()
-            .zip(self.vehicle.bodies.iter().zip(&self.states))
-        {
-            *w = Wrench::default();
-            w.force.z = -b.mass * g;
-            let _ = s;
-        }
-        for (e, m) in self.vehicle.elements.iter().zip(&mut self.memory) {
-            e.apply(&self.states, m, &mut self.wrenches);
-        }
-        // Wheelsets (contact) and the hauled body need their track frame every step; the
-        // others only when signals are sampled or the state is checked.
-        for k in 0..self.every_step.len() {
-            let i = self.every_step[k];
-            self.refresh_frame(i);
-        }
-        for e in &self.vehicle.elements {
-            if let Element::TrackSpring(ts) = e {
-                let f = &self.frames[ts.body];
-                ts.restore(&self.states, &f.origin, &f.axes, &mut self.wrenches);
-            }
-        }
-        self.contact()?;
+        self.forces(true)?;
         self.move_rails();
-        self.haul();
         // Semi-implicit Euler: velocities first, positions with the new velocities.
         for (i, (st, w)) in self.states.iter_mut().zip(&self.wrenches).enumerate() {
             let b = &self.vehicle.bodies[i];
@@ -407,6 +382,37 @@ impl<'a> Simulation<'a> {
         }
         self.time += dt;
         self.check()
+    }
+
+    /// Every force of the state as it stands: gravity, the force elements, the track springs,
+    /// the wheel–rail contact (and its reactions on the rails) and the hauling, into the
+    /// wrenches. `integrate_haul`: advance the speed controller's integral by one step (the
+    /// run); without it the forces are a pure function of the state (the linearisation of
+    /// [`modes`]).
+    pub(crate) fn forces(&mut self, integrate_haul: bool) -> Result<()> {
+        let g = crate::GRAVITY;
+        for (w, b) in self.wrenches.iter_mut().zip(&self.vehicle.bodies) {
+            *w = Wrench::default();
+            w.force.z = -b.mass * g;
+        }
+        for (e, m) in self.vehicle.elements.iter().zip(&mut self.memory) {
+            e.apply(&self.states, m, &mut self.wrenches);
+        }
+        // Wheelsets (contact) and the hauled body need their track frame every step; the
+        // others only when signals are sampled or the state is checked.
+        for k in 0..self.every_step.len() {
+            let i = self.every_step[k];
+            self.refresh_frame(i);
+        }
+        for e in &self.vehicle.elements {
+            if let Element::TrackSpring(ts) = e {
+                let f = &self.frames[ts.body];
+                ts.restore(&self.states, &f.origin, &f.axes, &mut self.wrenches);
+            }
+        }
+        self.contact()?;
+        self.haul(integrate_haul);
+        Ok(())
     }
 
     fn refresh_frame(&mut self, i: usize) {
@@ -429,7 +435,7 @@ impl<'a> Simulation<'a> {
 
     /// Speed control: the rest of the train pulls or brakes the wagon at the carbody, PI on
     /// the along-track speed plus the gradient's share of the weight as feed-forward.
-    fn haul(&mut self) {
+    fn haul(&mut self, integrate: bool) {
         let Some(h) = self.vehicle.hauling else {
             return;
         };
@@ -437,7 +443,9 @@ impl<'a> Simulation<'a> {
         let along = f.axes.column(0).into_owned();
         let v = self.states[h.body].velocity.dot(&along);
         let err = self.cfg.speed - v;
-        self.hauling_integral += err * self.cfg.dt;
+        if integrate {
+            self.hauling_integral += err * self.cfg.dt;
+        }
         let m = self.vehicle.mass();
         let force = m
             * (h.proportional * err

@@ -192,6 +192,17 @@ impl Vehicle {
         v
     }
 
+    /// The same vehicle with every friction element sliding freely: its friction coefficients
+    /// (and the wedges' warp break-out) set to zero, so it carries no friction force — the
+    /// `sliding` limit of the linear stability analysis ([`crate::sim::modes`]).
+    pub fn without_friction(&self) -> Vehicle {
+        let mut v = self.clone();
+        for e in &mut v.elements {
+            e.frictionless();
+        }
+        v
+    }
+
     /// Index of a body by name.
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)

@@ -165,4 +165,7 @@ impl ForceElement for CentrePlate {
     fn take_share(&mut self, share: f64) {
         self.preload = share;
     }
+    fn frictionless(&mut self) {
+        self.friction = 0.0;
+    }
 }

@@ -119,6 +119,8 @@ pub(crate) trait ForceElement: Sized {
     /// Once every static load is set: reads what other elements settled to (a wedge, its
     /// nest's static compression).
     fn settle(&mut self, _elements: &[Element]) {}
+    /// Sets its friction to zero (the sliding limit of a linear analysis).
+    fn frictionless(&mut self) {}
 }
 
 macro_rules! define_element {
@@ -188,6 +190,13 @@ macro_rules! define_element {
             pub(crate) fn settle(&mut self, elements: &[Element]) {
                 match self {
                     $(Element::$variant(e) => e.settle(elements),)*
+                }
+            }
+
+            /// Sets its friction to zero (the sliding limit of a linear analysis).
+            pub(crate) fn frictionless(&mut self) {
+                match self {
+                    $(Element::$variant(e) => e.frictionless(),)*
                 }
             }
 

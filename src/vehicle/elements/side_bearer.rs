@@ -152,4 +152,7 @@ impl ForceElement for SideBearer {
             preload: self.preload,
         })
     }
+    fn frictionless(&mut self) {
+        self.friction = 0.0;
+    }
 }

@@ -234,6 +234,10 @@ impl ForceElement for WedgeDamper {
             self.nest = nest.clone();
         }
     }
+    fn frictionless(&mut self) {
+        self.friction = 0.0;
+        self.warp_ratio = 0.0;
+    }
 }
 
 /// The first spring nest between bodies `upper` and `lower`.

@@ -1,0 +1,215 @@
+//! `railforce modes`: the linear stability of a vehicle against speed (root locus, damping,
+//! named modes, linear critical speeds), a thin shell over `sim::modes`.
+
+use anyhow::{Result, bail};
+use clap::Args;
+use railforce::report::svg::{Chart, Series};
+use railforce::sim::modes::{
+    Critical, FrictionLimit, ModesOptions, SpeedModes, critical_speeds, modes,
+};
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct ModesArgs {
+    /// Vehicle file (or a built-in name: c80, c80_empty, restrained_wheelset).
+    #[arg(long, default_value = "vehicles/c80.toml")]
+    vehicle: PathBuf,
+    /// Speeds, km/h, as FROM:TO:STEP.
+    #[arg(long, default_value = "20:200:5")]
+    speeds: String,
+    /// Amplitude of the contact's quasi-linearisation, mm: each wheelset's and rail's lateral
+    /// position is stepped by ± this much, so the contact enters as its secant over it (the
+    /// equivalent conicity at this amplitude, with the contact-angle and gravitational terms).
+    #[arg(long, default_value_t = 3.0)]
+    amplitude_mm: f64,
+    /// Friction elements stuck (their stick springs), sliding (no friction force) or both
+    /// (two loci).
+    #[arg(long, default_value = "both", value_parser = ["stuck", "sliding", "both"])]
+    friction: String,
+    /// Change the wheelsets' flange back-to-back distance by this many mm (S1002's conicity
+    /// turns with it: +7 mm takes the C80's 1 353 mm to S1002's design 1 360 mm).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    flange_back_change_mm: f64,
+    /// Rigid rails instead of the compliant rails of the paper's tracks (as Wickens' and
+    /// Klingel's closed forms assume).
+    #[arg(long)]
+    rigid_rails: bool,
+    /// Highest frequency of the modes reported, Hz.
+    #[arg(long, default_value_t = 20.0)]
+    max_frequency_hz: f64,
+    /// Output folder: modes.csv, modes.json, root_locus.svg, damping.svg.
+    #[arg(long, default_value = "modes")]
+    out: PathBuf,
+}
+
+pub fn run(args: ModesArgs) -> Result<()> {
+    let vehicle = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&args.vehicle)?)?
+        .with_flange_back_changed(args.flange_back_change_mm * 1e-3);
+    let mut spec = railforce::track::TrackSpec::load(&super::builtin::resolve(
+        std::path::Path::new("tracks/tangent.toml"),
+    )?)?;
+    spec.irregularity = None;
+    if args.rigid_rails {
+        spec.rail_support = None;
+    }
+    let track = railforce::track::Track::new(spec, None);
+    let speeds: Vec<f64> = super::contact::range(&args.speeds, "--speeds")?
+        .into_iter()
+        .map(|v| v / 3.6)
+        .collect();
+    if speeds.iter().any(|&v| v <= 0.0) {
+        bail!("--speeds {}: every speed must be positive", args.speeds);
+    }
+    let limits: Vec<FrictionLimit> = match args.friction.as_str() {
+        "stuck" => vec![FrictionLimit::Stuck],
+        "sliding" => vec![FrictionLimit::Sliding],
+        _ => vec![FrictionLimit::Stuck, FrictionLimit::Sliding],
+    };
+    let amplitude = args.amplitude_mm * 1e-3;
+    let conicity = vehicle.contact.table().equivalent_conicity(amplitude);
+    eprintln!(
+        "{}: {} speeds {:.0}–{:.0} km/h, contact quasi-linearised at {} mm (equivalent conicity {}), friction {}",
+        vehicle.name,
+        speeds.len(),
+        speeds[0] * 3.6,
+        speeds[speeds.len() - 1] * 3.6,
+        args.amplitude_mm,
+        conicity.map_or("—".into(), |l| format!("{l:.4}")),
+        args.friction
+    );
+    std::fs::create_dir_all(&args.out)?;
+    let mut csv = String::from(
+        "friction,speed_kmh,rank,frequency_hz,damping_ratio,real_per_s,imag_rad_per_s,name,dominant_body,dominant_dof,dominant_share\n",
+    );
+    let mut json_limits = serde_json::Map::new();
+    let mut locus = Vec::new();
+    let mut damping = Vec::new();
+    for limit in limits {
+        let t0 = std::time::Instant::now();
+        let sweep = modes(
+            &vehicle,
+            &track,
+            &ModesOptions {
+                speeds: speeds.clone(),
+                amplitude,
+                friction: limit,
+                max_frequency: args.max_frequency_hz,
+            },
+        )?;
+        let crit = critical_speeds(&sweep);
+        eprintln!(
+            "friction {}: {} speeds in {:.1} s",
+            limit.name(),
+            sweep.len(),
+            t0.elapsed().as_secs_f64()
+        );
+        print_critical(limit, &crit);
+        for s in &sweep {
+            for (k, m) in s.modes.iter().enumerate() {
+                csv += &format!(
+                    "{},{:.1},{},{:.4},{:.5},{:.5},{:.5},{},{},{},{:.3}\n",
+                    limit.name(),
+                    s.speed_kmh,
+                    k + 1,
+                    m.frequency_hz,
+                    m.damping_ratio,
+                    m.real,
+                    m.imag,
+                    m.name,
+                    m.dominant.0,
+                    m.dominant.1,
+                    m.dominant.2
+                );
+            }
+        }
+        charts(limit, &sweep, &crit, &mut locus, &mut damping);
+        json_limits.insert(
+            limit.name().into(),
+            serde_json::json!({"critical": crit, "sweep": sweep}),
+        );
+    }
+    let json = serde_json::json!({
+        "vehicle": vehicle.name,
+        "flange_back_m": vehicle.contact.geometry.flange_back,
+        "amplitude_mm": args.amplitude_mm,
+        "equivalent_conicity": conicity,
+        "creep": "linear Kalker (the run's creep law replaced for the linearisation)",
+        "track": "smooth tangent, compliant rails of tracks/tangent.toml",
+        "limits": json_limits,
+    });
+    let write = |name: &str, text: &str| {
+        railforce::io::write_atomic(&args.out.join(name), |w| w.write_all(text.as_bytes()))
+    };
+    write("modes.csv", &csv)?;
+    write("modes.json", &(serde_json::to_string_pretty(&json)? + "\n"))?;
+    let mut chart = Chart::new(
+        "Root locus: eigenvalues from 20 to 200 km/h",
+        "real part, 1/s (> 0 unstable)",
+        "frequency, Hz",
+        locus,
+    );
+    chart.size.1 = 520.0;
+    write("root_locus.svg", &chart.to_svg())?;
+    let mut chart = Chart::new(
+        "Damping ratio of each family's least damped mode",
+        "speed, km/h",
+        "damping ratio",
+        damping,
+    );
+    chart.size.1 = 460.0;
+    write("damping.svg", &chart.to_svg())?;
+    eprintln!(
+        "wrote modes.csv, modes.json, root_locus.svg, damping.svg in {}",
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn print_critical(limit: FrictionLimit, crit: &[Critical]) {
+    println!("friction {}:", limit.name());
+    println!(
+        "  {:<28} {:>18} {:>12} {:>14}",
+        "mode family", "linear critical", "frequency", "least damping"
+    );
+    for c in crit {
+        println!(
+            "  {:<28} {:>18} {:>9.2} Hz {:>14.4}",
+            c.name,
+            c.speed_kmh
+                .map_or("stable".to_string(), |v| format!("{v:.0} km/h")),
+            c.frequency_hz,
+            c.min_damping
+        );
+    }
+}
+
+/// The families that matter on a chart: hunting, sway, yaw (the rest are listed in the CSV).
+fn charts(
+    limit: FrictionLimit,
+    sweep: &[SpeedModes],
+    crit: &[Critical],
+    locus: &mut Vec<Series>,
+    damping: &mut Vec<Series>,
+) {
+    let mut names: Vec<&str> = crit.iter().map(|c| c.name.as_str()).collect();
+    names.retain(|n| n.contains("hunting") || n.contains("sway") || n.contains("carbody yaw"));
+    for name in names {
+        let mut pts = Vec::new();
+        let mut zeta = Vec::new();
+        for s in sweep {
+            let fam: Vec<_> = s.modes.iter().filter(|m| m.name == name).collect();
+            for m in &fam {
+                pts.push((m.real, m.frequency_hz));
+            }
+            if let Some(m) = fam
+                .iter()
+                .min_by(|a, b| a.damping_ratio.total_cmp(&b.damping_ratio))
+            {
+                zeta.push((s.speed_kmh, m.damping_ratio));
+            }
+        }
+        let label = format!("{name} ({})", limit.name());
+        locus.push(Series::points(label.clone(), pts));
+        damping.push(Series::line(label, zeta));
+    }
+}
