@@ -37,7 +37,15 @@ pub struct ModesArgs {
     /// Highest frequency of the modes reported, Hz.
     #[arg(long, default_value_t = 20.0)]
     max_frequency_hz: f64,
-    /// Output folder: modes.csv, modes.json, root_locus.svg, damping.svg.
+    /// Also the nonlinear view: kink-and-coast (from below the limit cycle, 6 mm kink, 2 m/s²)
+    /// and the run-down of Iwnicki et al. (2015: kicked onto the limit cycle at the top
+    /// speed, 1.5 m/s²) from the highest speed, their amplitudes against speed drawn as one
+    /// bifurcation chart, and each critical speed and limit-cycle frequency beside the linear
+    /// ones (about two minutes).
+    #[arg(long)]
+    nonlinear: bool,
+    /// Output folder: modes.csv, modes.json, root_locus.svg, damping.svg (and with
+    /// --nonlinear bifurcation.csv, bifurcation.svg).
     #[arg(long, default_value = "modes")]
     out: PathBuf,
 }
@@ -128,7 +136,13 @@ pub fn run(args: ModesArgs) -> Result<()> {
             serde_json::json!({"critical": crit, "sweep": sweep}),
         );
     }
+    let nonlinear = if args.nonlinear {
+        Some(bifurcation(&vehicle, &track, &speeds, &args.out)?)
+    } else {
+        None
+    };
     let json = serde_json::json!({
+        "nonlinear": nonlinear,
         "vehicle": vehicle.name,
         "flange_back_m": vehicle.contact.geometry.flange_back,
         "amplitude_mm": args.amplitude_mm,
@@ -212,4 +226,74 @@ fn charts(
         locus.push(Series::points(label.clone(), pts));
         damping.push(Series::line(label, zeta));
     }
+}
+
+/// Kink-and-coast and run-down from the highest speed of the sweep down to the lowest: the
+/// leading wheelset's amplitude against speed for both branches (bifurcation.csv, .svg), and
+/// each method's critical speed and limit-cycle frequency (printed, returned for the JSON).
+fn bifurcation(
+    vehicle: &railforce::vehicle::Vehicle,
+    track: &railforce::track::Track,
+    speeds: &[f64],
+    out: &std::path::Path,
+) -> Result<serde_json::Value> {
+    use railforce::sim::fidelity as fd;
+    let (from, to) = (speeds[speeds.len() - 1], speeds[0].max(50.0 / 3.6));
+    let runs = [
+        (
+            "kink-and-coast",
+            fd::critical_speed(vehicle, track, from, to, 2.0)?,
+        ),
+        ("run-down", fd::run_down(vehicle, track, from, to, 1.5)?),
+    ];
+    let mut csv = String::from("method,speed_kmh,amplitude_mm,frequency_hz\n");
+    let mut series = Vec::new();
+    let mut json = serde_json::Map::new();
+    println!(
+        "nonlinear, smooth tangent from {:.0} to {:.0} km/h:",
+        from * 3.6,
+        to * 3.6
+    );
+    for (name, run) in &runs {
+        let pts: Vec<(f64, f64)> = run
+            .blocks
+            .iter()
+            .skip(2)
+            .map(|(v, a)| (v * 3.6, a * 1e3))
+            .collect();
+        for ((v, a), f) in run.blocks.iter().zip(&run.frequencies).skip(2) {
+            csv += &format!("{name},{:.2},{:.3},{:.3}\n", v * 3.6, a * 1e3, f);
+        }
+        series.push(Series::points(name.to_string(), pts));
+        let (crit, freq) = (run.critical, run.cycle_frequency());
+        println!(
+            "  {name:<16} {}",
+            match (crit, freq) {
+                (Some(c), Some(f)) => format!(
+                    "hunting (≥ {:.1} mm) down to {:.0} km/h, limit cycle {f:.2} Hz there",
+                    fd::HUNTING_AMPLITUDE * 1e3,
+                    c * 3.6
+                ),
+                (Some(c), None) => format!("hunting down to {:.0} km/h", c * 3.6),
+                _ => "no hunting".into(),
+            }
+        );
+        json.insert(
+            name.to_string(),
+            serde_json::json!({"critical_kmh": crit.map(|c| c * 3.6), "cycle_frequency_hz": freq}),
+        );
+    }
+    let write = |name: &str, text: &str| {
+        railforce::io::write_atomic(&out.join(name), |w| w.write_all(text.as_bytes()))
+    };
+    write("bifurcation.csv", &csv)?;
+    let mut chart = Chart::new(
+        "Bifurcation: amplitude of the leading wheelset against speed, both branches",
+        "speed, km/h",
+        "half peak-to-peak lateral amplitude, mm",
+        series,
+    );
+    chart.size.1 = 440.0;
+    write("bifurcation.svg", &chart.to_svg())?;
+    Ok(serde_json::Value::Object(json))
 }

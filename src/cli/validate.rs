@@ -334,10 +334,12 @@ fn fidelity(
                 };
                 match c.critical {
                     Some(s) => println!(
-                        "    {method} from {:.0} km/h ({how}), {}: hunting dies out at {:.0} km/h",
+                        "    {method} from {:.0} km/h ({how}), {}: hunting dies out at {:.0} km/h{}",
                         from * 3.6,
                         w.name,
-                        s * 3.6
+                        s * 3.6,
+                        c.cycle_frequency()
+                            .map_or(String::new(), |f| format!(", limit cycle {f:.2} Hz there"))
                     ),
                     None => println!(
                         "    {method} from {:.0} km/h ({how}), {}: no hunting",
@@ -350,6 +352,47 @@ fn fidelity(
                         eprintln!("      {:.0} km/h: {:.2} mm", v * 3.6, a * 1e3);
                     }
                 }
+            }
+        }
+        // The linear view of the same wagons (railforce modes): the first family to lose its
+        // damping, stuck and sliding friction, beside the nonlinear critical speeds above.
+        for w in [&vl, &ve] {
+            for limit in [
+                railforce::sim::modes::FrictionLimit::Stuck,
+                railforce::sim::modes::FrictionLimit::Sliding,
+            ] {
+                let sweep = railforce::sim::modes::modes(
+                    w,
+                    &smooth,
+                    &railforce::sim::modes::ModesOptions {
+                        speeds: (10..=40).map(|k| k as f64 * 5.0 / 3.6).collect(),
+                        friction: limit,
+                        ..Default::default()
+                    },
+                )?;
+                let crit = railforce::sim::modes::critical_speeds(&sweep);
+                let first = crit
+                    .iter()
+                    .filter(|c| c.speed_kmh.is_some())
+                    .min_by(|a, b| {
+                        a.speed_kmh
+                            .unwrap_or(f64::INFINITY)
+                            .total_cmp(&b.speed_kmh.unwrap_or(f64::INFINITY))
+                    });
+                println!(
+                    "    linear, friction {}, {}: {}",
+                    limit.name(),
+                    w.name,
+                    match first {
+                        Some(c) => format!(
+                            "{} loses its damping at {:.0} km/h, {:.2} Hz",
+                            c.name,
+                            c.speed_kmh.unwrap_or(f64::NAN),
+                            c.frequency_hz
+                        ),
+                        None => "every mode damped from 50 to 200 km/h".into(),
+                    }
+                );
             }
         }
         let first = |s: [f64; 2]| s[1] < s[0];

@@ -30,6 +30,42 @@ pub struct CriticalSpeed {
     pub critical: Option<f64>,
     /// Speed and half peak-to-peak lateral amplitude of the leading wheelset per 1 s block.
     pub blocks: Vec<(f64, f64)>,
+    /// Frequency of the leading wheelset's lateral motion at each block, over the 3 s ending
+    /// with it (crossings of its mean), Hz; 0 where it crossed fewer than twice.
+    pub frequencies: Vec<f64>,
+}
+
+impl CriticalSpeed {
+    /// Frequency of the limit cycle where it last survived (the block at the critical
+    /// speed), Hz.
+    pub fn cycle_frequency(&self) -> Option<f64> {
+        let c = self.critical?;
+        self.blocks
+            .iter()
+            .zip(&self.frequencies)
+            .skip(2)
+            .take_while(|(b, _)| b.1 >= HUNTING_AMPLITUDE)
+            .filter(|(b, _)| b.0 <= c + 1e-9)
+            .map(|(_, f)| *f)
+            .last()
+    }
+}
+
+/// Half peak-to-peak lateral amplitude of the leading wheelset over a 1 s block from which a
+/// wagon is said to hunt, m.
+pub const HUNTING_AMPLITUDE: f64 = 1.5e-3;
+
+/// Frequency of `x` by upward crossings of its mean, Hz (`dt` s between samples; 0 with fewer
+/// than two crossings).
+fn crossing_frequency(x: &[f64], dt: f64) -> f64 {
+    let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
+    let ups: Vec<usize> = (1..x.len())
+        .filter(|&i| x[i - 1] < mean && x[i] >= mean)
+        .collect();
+    match (ups.first(), ups.last()) {
+        (Some(a), Some(b)) if b > a => (ups.len() - 1) as f64 / ((b - a) as f64 * dt),
+        _ => 0.0,
+    }
 }
 
 /// A run that starts 6 mm off the centre line (the kink) at `speed`, without settling, and
@@ -100,8 +136,9 @@ fn coast(
     let lead = 0;
     let steps_per_block = (1.0 / sim.config().dt).round() as usize;
     let mut blocks = Vec::new();
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut n = 0;
+    let mut frequencies = Vec::new();
+    let mut block = Vec::with_capacity(steps_per_block);
+    let mut window: Vec<f64> = Vec::new();
     let mut kick = kick;
     while sim.time() < duration {
         let t = sim.time();
@@ -123,24 +160,36 @@ fn coast(
         };
         sim.set_speed(v);
         sim.step()?;
-        let y = sim.wheels[2 * lead].y_centre;
-        lo = lo.min(y);
-        hi = hi.max(y);
-        n += 1;
-        if n == steps_per_block {
+        block.push(sim.wheels[2 * lead].y_centre);
+        if block.len() == steps_per_block {
+            let (lo, hi) = block
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| {
+                    (l.min(*y), h.max(*y))
+                });
             blocks.push((v, 0.5 * (hi - lo)));
-            (lo, hi, n) = (f64::INFINITY, f64::NEG_INFINITY, 0);
+            window.extend_from_slice(&block);
+            let keep = 3 * steps_per_block;
+            if window.len() > keep {
+                window.drain(..window.len() - keep);
+            }
+            frequencies.push(crossing_frequency(&window, sim.config().dt));
+            block.clear();
         }
     }
     // Skip the first 2 s (the kink's own transient).
-    let hunting = |a: f64| a >= 1.5e-3;
+    let hunting = |a: f64| a >= HUNTING_AMPLITUDE;
     let critical = blocks
         .iter()
         .skip(2)
         .take_while(|b| hunting(b.1))
         .last()
         .map(|b| b.0);
-    Ok(CriticalSpeed { critical, blocks })
+    Ok(CriticalSpeed {
+        critical,
+        blocks,
+        frequencies,
+    })
 }
 
 /// Roll of the side frames relative to the track frame (the `sideframe*_roll` channels):
@@ -233,14 +282,7 @@ pub fn settled(
             });
         if x.is_empty() { 0.0 } else { 0.5 * (hi - lo) }
     };
-    let mean = w.iter().sum::<f64>() / w.len().max(1) as f64;
-    let ups: Vec<usize> = (1..w.len())
-        .filter(|&i| w[i - 1] < mean && w[i] >= mean)
-        .collect();
-    let frequency = match (ups.first(), ups.last()) {
-        (Some(a), Some(b)) if b > a => (ups.len() - 1) as f64 / ((b - a) as f64 * sim.config().dt),
-        _ => 0.0,
-    };
+    let frequency = crossing_frequency(&w, sim.config().dt);
     Ok(Settled {
         wheelset: half_range(&w),
         carbody: half_range(&c),
