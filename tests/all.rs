@@ -8,6 +8,8 @@ mod assess;
 mod bogie;
 #[path = "cli.rs"]
 mod cli;
+#[path = "cli_daily.rs"]
+mod cli_daily;
 #[path = "common/mod.rs"]
 mod common;
 #[path = "contact.rs"]
