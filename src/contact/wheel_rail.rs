@@ -174,6 +174,19 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 /// The one contact evaluation: the rail's forces on one wheel in the state `w`, from the
 /// vehicle's contact table and settings.
+///
+/// ```no_run
+/// use railforce::contact::{Side, WheelOnRail, evaluate, height_for_load};
+/// use railforce::vehicle::Vehicle;
+/// let v = Vehicle::load("vehicles/c80.toml".as_ref())?;
+/// let (table, model) = (v.contact.table(), v.contact.model());
+/// let mut w = WheelOnRail::rolling(Side::Left, 60.0 / 3.6, 0.42, 0.0, 650.0);
+/// w.y = 3e-3; // the wheelset 3 mm to the left
+/// w.height = height_for_load(table, &model, &w, 122.6e3);
+/// let f = evaluate(table, &model, &w);
+/// println!("Y {:.1} kN, Q {:.1} kN", f.force[1] / 1e3, f.force[2] / 1e3);
+/// # Ok::<(), railforce::Error>(())
+/// ```
 pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> WheelForces {
     let k = match w.side {
         Side::Left => 0,

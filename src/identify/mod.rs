@@ -247,6 +247,17 @@ fn interpolate(t: &[f64], v: &[f64], at: &[f64]) -> Vec<f64> {
 pub type Identified = crate::assess::ForceSeries;
 
 /// Identifies forces over a whole checked recording (one estimate per complete window).
+///
+/// ```no_run
+/// use railforce::identify::{SensorTable, check, identify};
+/// use railforce::learn::model::Model;
+/// let mut model = Model::load("models/demo".as_ref())?;
+/// let table = SensorTable::read("run.csv".as_ref())?;
+/// let input = check(&table, &model, false)?; // channels, rate, gaps, NaN
+/// let forces = identify(&mut model, &input);
+/// println!("{} estimates of {:?}", forces.time.len(), forces.targets);
+/// # Ok::<(), railforce::Error>(())
+/// ```
 pub fn identify(model: &mut Model, input: &CheckedInput) -> Identified {
     let spec = model.meta.data.clone();
     let (w, c) = (spec.window, spec.channels.len());

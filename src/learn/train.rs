@@ -125,6 +125,28 @@ struct Checkpoint {
 }
 
 /// Trains `kind` on `ds` and writes the model directory `out`.
+///
+/// ```no_run
+/// use railforce::dataset::DataSet;
+/// use railforce::features::{LabelAt, Split};
+/// use railforce::learn::model::ModelKind;
+/// use railforce::learn::train::{TrainOptions, train};
+/// use railforce::learn::windows::{DataRequest, DataSpec};
+/// let ds = DataSet::load("data/demo".as_ref())?; // written by `railforce generate`
+/// let req = DataRequest {
+///     channels: railforce::sensors::PAPER_CHANNELS.iter().map(|c| c.to_string()).collect(),
+///     targets: "both".into(),
+///     window: 20,
+///     label_at: LabelAt::Centre,
+///     stride: 1,
+///     split: Split::standard(&ds),
+///     noise: None,
+/// };
+/// let spec = DataSpec::resolve(&req, &ds)?;
+/// let opts = TrainOptions::default();
+/// let model = train(&ds, &spec, ModelKind::CnnBiLstm, &opts, "models/demo".as_ref(), &mut |_| {})?;
+/// # Ok::<(), railforce::Error>(())
+/// ```
 pub fn train(
     ds: &DataSet,
     spec: &DataSpec,

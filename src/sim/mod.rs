@@ -360,6 +360,21 @@ impl<'a> Simulation<'a> {
     }
 
     /// Advances one integration step.
+    ///
+    /// ```no_run
+    /// use railforce::sim::{SimConfig, Simulation};
+    /// use railforce::{track::Track, vehicle::Vehicle};
+    /// let vehicle = Vehicle::load("vehicles/c80.toml".as_ref())?;
+    /// let track = Track::load("tracks/curve_r400.toml".as_ref())?;
+    /// let cfg = SimConfig { speed: 60.0 / 3.6, ..SimConfig::default() };
+    /// let mut sim = Simulation::new(&vehicle, &track, cfg)?;
+    /// sim.settle()?;
+    /// for _ in 0..5_000 {
+    ///     sim.step()?; // 1 s at the 0.2 ms step
+    /// }
+    /// println!("Q of wheel 1L: {:.1} kN", sim.wheels[0].q / 1e3);
+    /// # Ok::<(), railforce::Error>(())
+    /// ```
     pub fn step(&mut self) -> Result<()> {
         let dt = self.cfg.dt;
         self.forces(true)?;

@@ -139,7 +139,7 @@ impl BiLstm {
     /// Evaluation-mode forward: `x[B, T, D]` → final states `out[B, 2H]`, keeping no caches.
     /// The input projection is one matrix product (both biases folded into its initial
     /// value); the recurrence runs window by window with the recurrent product and the cell
-    /// fused ([`Recurrence`]), the state held in registers. Same numbers as [`BiLstm::forward`]
+    /// fused (`Recurrence`), the state held in registers. Same numbers as [`BiLstm::forward`]
     /// up to rounding.
     pub fn forward_eval(
         &mut self,
