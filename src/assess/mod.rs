@@ -10,10 +10,10 @@
 
 mod compare;
 pub mod criteria;
-pub mod ride;
+mod ride;
 pub mod safety;
 mod section;
-pub mod statistics;
+mod statistics;
 
 use crate::dsp::{Butterworth, percentile};
 use crate::error::{Error, Result};

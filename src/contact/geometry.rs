@@ -93,7 +93,7 @@ pub struct ContactState {
     /// Main contact on each wheel (left, right).
     pub wheels: [WheelContact; 2],
     /// Second contact (e.g. flange beside tread) where a second gap minimum lies within
-    /// [`SECONDARY_GAP`].
+    /// `SECONDARY_GAP` (1 mm).
     pub secondary: [Option<WheelContact>; 2],
 }
 

@@ -1,15 +1,15 @@
 //! Wheel–rail contact: profiles, contact geometry, Hertz normal contact, creep forces.
 
-pub mod creep;
-pub mod elastic;
-pub mod geometry;
-pub mod hertz;
-pub mod kalker;
+mod creep;
+mod elastic;
+mod geometry;
+mod hertz;
+mod kalker;
 pub mod profile;
 mod quasi_static;
 mod table;
 pub mod validate;
-pub mod wheel_rail;
+mod wheel_rail;
 
 pub use creep::{CreepContact, CreepForce, CreepLaw, Creepage};
 pub use geometry::{ContactState, Side, WheelContact, WheelsetGeometry};

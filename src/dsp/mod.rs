@@ -1,8 +1,8 @@
 //! Signal processing shared by several stages (spectral estimates, filters).
 
-pub mod butterworth;
-pub mod spectrum;
-pub mod stats;
+mod butterworth;
+mod spectrum;
+mod stats;
 pub mod welch;
 
 pub use butterworth::Butterworth;

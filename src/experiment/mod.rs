@@ -10,7 +10,7 @@
 mod assessment;
 mod comparison;
 mod generalization;
-pub mod paper;
+mod paper;
 mod protocols;
 mod robustness;
 mod sensors;

@@ -1,10 +1,10 @@
 //! From data sets to learning: leak-free samples, mutual-information filter, wrapper
 //! selection, and the selection file that training reads.
 
-pub mod mutual_info;
-pub mod samples;
-pub mod split;
-pub mod wrapper;
+mod mutual_info;
+mod samples;
+mod split;
+mod wrapper;
 
 pub use samples::{Block, LabelAt, NoiseProtocol, Part, Samples, Split, Window, ZScore};
 pub use split::{SPLIT_KINDS, SplitRequest};

@@ -6,7 +6,7 @@ pub mod burn;
 pub mod classical;
 pub mod evaluate;
 pub mod export;
-pub mod gradient;
+mod gradient;
 pub mod linalg;
 pub mod metrics;
 pub mod model;

@@ -14,7 +14,7 @@
 
 pub mod checks;
 pub mod fidelity;
-pub mod filter;
+mod filter;
 pub mod modes;
 pub mod output;
 mod track_frame;

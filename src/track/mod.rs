@@ -4,12 +4,12 @@
 //! along the centre line, a [`TrackPoint`]: position and heading in the plane, curvature,
 //! cant, elevation and gradient, and the irregular offsets of both rails.
 
-pub mod alignment;
+mod alignment;
 pub mod check;
 mod file;
 pub mod irregularity;
-pub mod profile;
-pub mod support;
+mod profile;
+mod support;
 
 pub use alignment::{Alignment, Section, SectionKind, Turn, cant_deficiency_acceleration};
 pub use file::{MAX_CANT_MM, MAX_GRADIENT_PERMILLE, TrackSpec};

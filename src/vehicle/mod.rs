@@ -3,7 +3,7 @@
 //! does not live in the URDF).
 
 mod binder;
-pub mod body;
+mod body;
 pub mod elements;
 mod file;
 mod urdf;

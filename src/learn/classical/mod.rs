@@ -2,10 +2,10 @@
 //! XGBoost-style histogram boosting and a decision tree (assets/docs/learning.md §3). Written here
 //! rather than taken from a crate; see assets/docs/results.md (learning engine) for the measurements behind that.
 
-pub mod binning;
-pub mod boosting;
-pub mod svr;
-pub mod tree;
+mod binning;
+mod boosting;
+mod svr;
+mod tree;
 
 use binning::Bins;
 use boosting::{BoostParams, Booster};

@@ -2,11 +2,11 @@
 //! hand-fused forward and backward passes on f32 buffers: the fast CPU path (the same networks
 //! as burn modules are in `learn::burn`, `--features burn`).
 
-pub mod adam;
+mod adam;
 pub mod batch_norm;
-pub mod dense;
-pub mod gru;
-pub mod lstm;
+mod dense;
+mod gru;
+mod lstm;
 pub mod network;
 pub mod params;
 
