@@ -254,3 +254,52 @@ fn profile_files_load_and_bad_ones_fail_clearly() {
         assert!(e.contains(name) && e.contains(want), "{name}: {e}");
     }
 }
+
+/// The worn heavy-haul pair carried in `vehicles/profiles/` (converted from CONTACT's test
+/// bank, the originals unchanged in `assets/reference/profiles/`) reads as the SIMPACK files
+/// it came from: the wheel is the `.prw` shifted 70 mm to its tape line, the rail the `.prr`
+/// less the under-turned corners of its head, which the SIMPACK reader refuses naming the file
+/// and the point (its y turns back).
+#[test]
+fn worn_heavy_haul_pair_equals_its_simpack_originals() {
+    use railforce::contact::profile::{LoadOptions, load};
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let wheel_csv = load(
+        &root.join("vehicles/profiles/worn_heavy_haul_wheel.csv"),
+        LoadOptions::default(),
+    )
+    .unwrap();
+    let wheel_prw = load(
+        &root.join("assets/reference/profiles/worn_high_mileage.prw"),
+        LoadOptions::default(),
+    )
+    .unwrap();
+    let (lo, hi) = wheel_csv.range();
+    let n = 200;
+    for i in 0..=n {
+        let y = lo + (hi - lo) * i as f64 / n as f64;
+        let (a, b) = (wheel_csv.eval(y).0, wheel_prw.eval(y + 0.070).0);
+        assert!((a - b).abs() < 1e-9, "wheel at y {y}: {a} vs {b}");
+    }
+    let err = load(
+        &root.join("assets/reference/profiles/site_b_hr.prr"),
+        LoadOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("site_b_hr.prr") && err.contains("not strictly monotonic at point"),
+        "{err}"
+    );
+    let rail = load(
+        &root.join("vehicles/profiles/worn_heavy_haul_rail.csv"),
+        LoadOptions::default(),
+    )
+    .unwrap();
+    // The crown is at the file's z = 0, 16.4 mm to the field side of its origin.
+    let (y_top, z_top) = rail.lowest_z();
+    assert!(
+        (y_top - 0.0164).abs() < 1e-3 && z_top.abs() < 1e-6,
+        "{y_top} {z_top}"
+    );
+}

@@ -44,6 +44,14 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../vehicles/profiles/cone_1_40.csv"),
     ),
     (
+        "vehicles/profiles/worn_heavy_haul_wheel.csv",
+        include_str!("../../vehicles/profiles/worn_heavy_haul_wheel.csv"),
+    ),
+    (
+        "vehicles/profiles/worn_heavy_haul_rail.csv",
+        include_str!("../../vehicles/profiles/worn_heavy_haul_rail.csv"),
+    ),
+    (
         "tracks/curve_r1000.toml",
         include_str!("../../tracks/curve_r1000.toml"),
     ),

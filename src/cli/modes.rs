@@ -30,6 +30,21 @@ pub struct ModesArgs {
     /// turns with it: +7 mm takes the C80's 1 353 mm to S1002's design 1 360 mm).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     flange_back_change_mm: f64,
+    /// Wheel profile instead of the vehicle's: `s1002` or a file (2-column y,z in mm, or
+    /// SIMPACK .prw), e.g. vehicles/profiles/worn_heavy_haul_wheel.csv.
+    #[arg(long)]
+    wheel_profile: Option<String>,
+    /// Rail profile instead of the vehicle's: `60kg` or a file (2-column, or SIMPACK .prr),
+    /// e.g. vehicles/profiles/worn_heavy_haul_rail.csv.
+    #[arg(long)]
+    rail_profile: Option<String>,
+    /// Rail inclination 1:N of a --rail-profile (0 when it is already in track position).
+    #[arg(long, default_value_t = 40.0, value_name = "N")]
+    rail_inclination: f64,
+    /// Flange back-to-back distance with a --wheel-profile/--rail-profile, mm [default: the
+    /// vehicle's].
+    #[arg(long)]
+    flange_back_mm: Option<f64>,
     /// Rigid rails instead of the compliant rails of the paper's tracks (as Wickens' and
     /// Klingel's closed forms assume).
     #[arg(long)]
@@ -51,8 +66,36 @@ pub struct ModesArgs {
 }
 
 pub fn run(args: ModesArgs) -> Result<()> {
-    let vehicle = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&args.vehicle)?)?
-        .with_flange_back_changed(args.flange_back_change_mm * 1e-3);
+    let mut vehicle = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&args.vehicle)?)?;
+    if args.wheel_profile.is_some() || args.rail_profile.is_some() {
+        let geo = &vehicle.contact.geometry;
+        let profile =
+            |given: &Option<String>, own: &railforce::contact::Profile, wheel: bool| match given {
+                None => Ok(own.clone()),
+                Some(p) => {
+                    let p = super::builtin::resolve(std::path::Path::new(p))
+                        .map(|p| p.to_string_lossy().into_owned())
+                        .unwrap_or_else(|_| p.clone());
+                    if wheel {
+                        railforce::contact::profile::wheel_by_name_or_file(&p)
+                    } else {
+                        railforce::contact::profile::rail_by_name_or_file(&p)
+                    }
+                }
+            };
+        let wheel = profile(&args.wheel_profile, geo.wheel(), true)?;
+        let rail = profile(&args.rail_profile, geo.rail(), false)?;
+        let inclination = if args.rail_profile.is_none() || args.rail_inclination <= 0.0 {
+            0.0 // the vehicle's rail is already inclined in its geometry
+        } else {
+            (1.0 / args.rail_inclination).atan()
+        };
+        let fb = args.flange_back_mm.map_or(geo.flange_back, |f| f * 1e-3);
+        vehicle = vehicle.with_profile_pair(wheel, rail, inclination, fb)?;
+    } else if let Some(f) = args.flange_back_mm {
+        vehicle = vehicle.with_flange_back_changed(f * 1e-3 - vehicle.contact.geometry.flange_back);
+    }
+    let vehicle = vehicle.with_flange_back_changed(args.flange_back_change_mm * 1e-3);
     let mut spec = railforce::track::TrackSpec::load(&super::builtin::resolve(
         std::path::Path::new("tracks/tangent.toml"),
     )?)?;

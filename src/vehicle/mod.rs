@@ -192,6 +192,34 @@ impl Vehicle {
         v
     }
 
+    /// The same vehicle on another wheel–rail pair: `wheel` and `rail` profiles (the rail
+    /// inclined by `inclination`, rad; 0 when the profile is already in track position) with the
+    /// wheelsets' flange back-to-back distance `flange_back` (m); gauge, tape offset and wheel
+    /// radius stay the vehicle's. For stability against conicity (`railforce modes
+    /// --wheel-profile …`).
+    pub fn with_profile_pair(
+        &self,
+        wheel: crate::contact::Profile,
+        rail: crate::contact::Profile,
+        inclination: f64,
+        flange_back: f64,
+    ) -> Result<Vehicle> {
+        let g = &self.contact.geometry;
+        let tape_offset = g.tape_circle_half - 0.5 * g.flange_back;
+        let mut v = self.clone();
+        v.contact.geometry = WheelsetGeometry::new(
+            wheel,
+            rail,
+            inclination,
+            2.0 * g.half_gauge,
+            flange_back,
+            tape_offset,
+            g.nominal_radius,
+        )?;
+        v.contact.table = std::sync::OnceLock::new();
+        Ok(v)
+    }
+
     /// The same vehicle with every friction element sliding freely: its friction coefficients
     /// (and the wedges' warp break-out) set to zero, so it carries no friction force — the
     /// `sliding` limit of the linear stability analysis ([`crate::sim::modes`]).
