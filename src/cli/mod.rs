@@ -67,7 +67,7 @@ enum Command {
     /// two loci. Modes are named by where their kinetic energy lies (wheelset hunting, bogie
     /// hunting, carbody lower and upper sway, yaw …).
     #[command(
-        after_help = "Examples:\n  railforce modes --vehicle c80 --speeds 20:200:10 --out modes_c80\n  railforce modes --vehicle c80_empty --flange-back-change-mm 7 --friction stuck --out modes_empty_1360"
+        after_help = "Examples:\n  railforce modes --vehicle c80 --speeds 20:200:10 --out modes_c80\n  railforce modes --vehicle c80_empty --flange-back-change-mm 7 --friction stuck --out modes_empty_1360\n  railforce modes --vehicle c80 --pairs --out pairs_c80"
     )]
     Modes(modes::ModesArgs),
     /// Simulate a vehicle on a track and record the 21 sensor channels, the forces of every

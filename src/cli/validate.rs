@@ -318,72 +318,56 @@ fn fidelity(
                 g.flange_back * 1e3
             ),
         }
+        // All three views of both wagons on this pair (sim::modes::compare): the nonlinear
+        // critical speeds with their limit cycles, and the first mode to lose its damping.
+        let steps = ((from - to) * 3.6 / 5.0).round() as usize;
+        let sweep: Vec<f64> = (0..=steps).map(|k| to + k as f64 * 5.0 / 3.6).collect();
+        let rows = [
+            railforce::sim::modes::compare(&vl, &smooth, &sweep, true)?,
+            railforce::sim::modes::compare(&ve, &smooth, &sweep, true)?,
+        ];
         let mut speeds = [[f64::INFINITY; 2]; 2];
         for (m, method) in ["kink-and-coast", "run-down"].iter().enumerate() {
-            for (k, w) in [&vl, &ve].into_iter().enumerate() {
-                let c = if m == 0 {
-                    fd::critical_speed(w, &smooth, from, to, 2.0)?
+            for (k, r) in rows.iter().enumerate() {
+                let n = if m == 0 {
+                    r.kink_and_coast.as_ref()
                 } else {
-                    fd::run_down(w, &smooth, from, to, 1.5)?
-                };
-                speeds[m][k] = c.critical.unwrap_or(f64::INFINITY);
+                    r.run_down.as_ref()
+                }
+                .expect("compare ran the nonlinear methods");
+                speeds[m][k] = n.critical_kmh.map_or(f64::INFINITY, |v| v / 3.6);
                 let how = if m == 0 {
                     "6 mm kink, 2 m/s²".to_string()
                 } else {
                     format!("kicked {} m/s, 1.5 m/s²", fd::RUN_DOWN_KICK)
                 };
-                match c.critical {
+                match n.critical_kmh {
                     Some(s) => println!(
-                        "    {method} from {:.0} km/h ({how}), {}: hunting dies out at {:.0} km/h{}",
+                        "    {method} from {:.0} km/h ({how}), {}: hunting dies out at {s:.0} km/h{}",
                         from * 3.6,
-                        w.name,
-                        s * 3.6,
-                        c.cycle_frequency()
+                        r.vehicle,
+                        n.frequency_hz
                             .map_or(String::new(), |f| format!(", limit cycle {f:.2} Hz there"))
                     ),
                     None => println!(
                         "    {method} from {:.0} km/h ({how}), {}: no hunting",
                         from * 3.6,
-                        w.name
+                        r.vehicle
                     ),
                 }
                 if std::env::var_os("RAILFORCE_VERBOSE").is_some() {
-                    for (v, a) in &c.blocks {
-                        eprintln!("      {:.0} km/h: {:.2} mm", v * 3.6, a * 1e3);
+                    for (v, a) in &n.amplitude_mm {
+                        eprintln!("      {v:.0} km/h: {a:.2} mm");
                     }
                 }
             }
         }
-        // The linear view of the same wagons (railforce modes): the first family to lose its
-        // damping, stuck and sliding friction, beside the nonlinear critical speeds above.
-        for w in [&vl, &ve] {
-            for limit in [
-                railforce::sim::modes::FrictionLimit::Stuck,
-                railforce::sim::modes::FrictionLimit::Sliding,
-            ] {
-                let sweep = railforce::sim::modes::modes(
-                    w,
-                    &smooth,
-                    &railforce::sim::modes::ModesOptions {
-                        speeds: (10..=40).map(|k| k as f64 * 5.0 / 3.6).collect(),
-                        friction: limit,
-                        ..Default::default()
-                    },
-                )?;
-                let crit = railforce::sim::modes::critical_speeds(&sweep);
-                let first = crit
-                    .iter()
-                    .filter(|c| c.speed_kmh.is_some())
-                    .min_by(|a, b| {
-                        a.speed_kmh
-                            .unwrap_or(f64::INFINITY)
-                            .total_cmp(&b.speed_kmh.unwrap_or(f64::INFINITY))
-                    });
+        for r in &rows {
+            for (limit, c) in [("stuck", &r.stuck), ("sliding", &r.sliding)] {
                 println!(
-                    "    linear, friction {}, {}: {}",
-                    limit.name(),
-                    w.name,
-                    match first {
+                    "    linear, friction {limit}, {}: {}",
+                    r.vehicle,
+                    match c {
                         Some(c) => format!(
                             "{} loses its damping at {:.0} km/h, {:.2} Hz",
                             c.name,

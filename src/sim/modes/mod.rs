@@ -127,7 +127,7 @@ pub struct SpeedModes {
 
 /// A family's linear critical speed: the lowest speed at which its least damped mode's
 /// damping ratio falls through zero.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Critical {
     /// Mode family.
     pub name: String,
@@ -265,8 +265,11 @@ pub fn critical_speeds(sweep: &[SpeedModes]) -> Vec<Critical> {
         .collect()
 }
 
+mod compare;
 mod eigen;
 mod linear;
 mod naming;
+
+pub use compare::{Comparison, Nonlinear, compare};
 
 use linear::Linear;

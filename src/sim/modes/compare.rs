@@ -1,0 +1,113 @@
+//! One wagon on one wheel–rail pair in all three views: the equivalent conicity, the first
+//! mode to lose its damping with friction stuck and sliding (linear), and the critical speeds
+//! of kink-and-coast and the run-down with their limit cycles' frequencies (nonlinear). The
+//! table of `validate dynamics` and the pair sweep of `railforce modes --pairs` are rows of it.
+
+use super::{Critical, FrictionLimit, ModesOptions, critical_speeds, modes};
+use crate::error::Result;
+use crate::sim::fidelity::{CriticalSpeed, critical_speed, run_down};
+use crate::track::Track;
+use crate::vehicle::Vehicle;
+use serde::Serialize;
+
+/// A nonlinear method's verdict.
+#[derive(Debug, Clone, Serialize)]
+pub struct Nonlinear {
+    /// Lowest speed at which the hunting cycle survived, km/h (`None`: no hunting).
+    pub critical_kmh: Option<f64>,
+    /// Frequency of the limit cycle there, Hz.
+    pub frequency_hz: Option<f64>,
+    /// Speed (km/h) and half peak-to-peak amplitude of the leading wheelset (mm) per second.
+    pub amplitude_mm: Vec<(f64, f64)>,
+}
+
+impl From<&CriticalSpeed> for Nonlinear {
+    fn from(c: &CriticalSpeed) -> Self {
+        Nonlinear {
+            critical_kmh: c.critical.map(|v| v * 3.6),
+            frequency_hz: c.cycle_frequency(),
+            amplitude_mm: c
+                .blocks
+                .iter()
+                .skip(2)
+                .map(|(v, a)| (v * 3.6, a * 1e3))
+                .collect(),
+        }
+    }
+}
+
+/// One wagon on one pair.
+#[derive(Debug, Clone, Serialize)]
+pub struct Comparison {
+    /// Vehicle name.
+    pub vehicle: String,
+    /// Flange back-to-back distance, m.
+    pub flange_back_m: f64,
+    /// Equivalent conicity at 3 mm (EN 15302).
+    pub conicity: Option<f64>,
+    /// The first family to lose its damping, friction stuck (`None`: all damped).
+    pub stuck: Option<Critical>,
+    /// The same, friction sliding.
+    pub sliding: Option<Critical>,
+    /// Kink-and-coast (6 mm kink, 2 m/s²), when run.
+    pub kink_and_coast: Option<Nonlinear>,
+    /// The run-down (kicked at the top speed, 1.5 m/s²), when run.
+    pub run_down: Option<Nonlinear>,
+}
+
+/// The three views of `vehicle` on the smooth tangent `track` over `speeds` (m/s, ascending;
+/// the nonlinear runs coast from the highest to the lowest, at least 50 km/h) — the nonlinear
+/// ones only when `nonlinear`.
+pub fn compare(
+    vehicle: &Vehicle,
+    track: &Track,
+    speeds: &[f64],
+    nonlinear: bool,
+) -> Result<Comparison> {
+    let first = |limit| -> Result<Option<Critical>> {
+        let sweep = modes(
+            vehicle,
+            track,
+            &ModesOptions {
+                speeds: speeds.to_vec(),
+                friction: limit,
+                ..ModesOptions::default()
+            },
+        )?;
+        Ok(critical_speeds(&sweep)
+            .into_iter()
+            .filter(|c| c.speed_kmh.is_some())
+            .min_by(|a, b| {
+                a.speed_kmh
+                    .unwrap_or(f64::INFINITY)
+                    .total_cmp(&b.speed_kmh.unwrap_or(f64::INFINITY))
+            }))
+    };
+    let (from, to) = (
+        speeds.last().copied().unwrap_or(200.0 / 3.6),
+        speeds
+            .first()
+            .copied()
+            .unwrap_or(50.0 / 3.6)
+            .max(50.0 / 3.6),
+    );
+    let (kink, down) = if nonlinear {
+        (
+            Some(Nonlinear::from(&critical_speed(
+                vehicle, track, from, to, 2.0,
+            )?)),
+            Some(Nonlinear::from(&run_down(vehicle, track, from, to, 1.5)?)),
+        )
+    } else {
+        (None, None)
+    };
+    Ok(Comparison {
+        vehicle: vehicle.name.clone(),
+        flange_back_m: vehicle.contact.geometry.flange_back,
+        conicity: vehicle.contact.table().equivalent_conicity(3e-3),
+        stuck: first(FrictionLimit::Stuck)?,
+        sliding: first(FrictionLimit::Sliding)?,
+        kink_and_coast: kink,
+        run_down: down,
+    })
+}
