@@ -166,3 +166,35 @@ fn c80_modes_are_named_and_sliding_friction_lowers_the_critical_speed() {
     // Without friction the body modes lose their damping: unstable at a lower speed.
     assert!(first(&sliding) < first(&stuck), "{sliding:?} {stuck:?}");
 }
+
+/// A rigid body on springs: a 1 000 kg box on two vertical springs of 1 MN/m over a wheelset
+/// bounces at `√(k/m)/2π` within 0.5 % (the contact in series is a thousand times stiffer).
+#[test]
+fn rigid_body_on_springs_bounces_at_its_closed_form() {
+    let v = Vehicle::load(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/vehicles/box_on_pads.toml"),
+    )
+    .unwrap();
+    let sweep = modes(
+        &v,
+        &smooth_tangent(300.0),
+        &ModesOptions {
+            speeds: vec![10.0 / 3.6],
+            friction: FrictionLimit::Stuck,
+            max_frequency: 30.0,
+            ..ModesOptions::default()
+        },
+    )
+    .unwrap();
+    let bounce = sweep[0]
+        .modes
+        .iter()
+        .find(|m| m.name == "box vertical")
+        .unwrap_or_else(|| panic!("{:#?}", sweep[0].modes));
+    let closed = (2.0e6f64 / 1000.0).sqrt() / (2.0 * std::f64::consts::PI);
+    assert!(
+        (bounce.frequency_hz / closed - 1.0).abs() < 0.005,
+        "{} Hz vs {closed} Hz",
+        bounce.frequency_hz
+    );
+}
