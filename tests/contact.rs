@@ -303,3 +303,75 @@ fn worn_heavy_haul_pair_equals_its_simpack_originals() {
         "{y_top} {z_top}"
     );
 }
+
+/// MiniProf files read as CONTACT reads them: the benchmark's UIC60 rail in the regular format,
+/// mirrored as CONTACT's example mirrors it, equals its SIMPACK copy; a measured wheel in the old format keeps its
+/// flange and tread past a glitch at the flange tip and gives a conicity on that rail; a jump,
+/// metres and a profile that turns back near the top are refused naming the file and line.
+#[test]
+fn miniprof_files_read_as_contact_reads_them() {
+    use railforce::contact::profile::{LoadOptions, load, parse};
+    let refdir =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/reference/profiles");
+    // MiniProf rails are measured with the field side to −y: mirrored, as CONTACT's own
+    // benchmark example reads this file (examples/python_mbench.py, mirror_y = 1).
+    let ban = load(
+        &refdir.join("MBench_UIC60_v3.ban"),
+        LoadOptions { mirror_y: true },
+    )
+    .unwrap();
+    let prr = load(&refdir.join("MBench_UIC60_v3.prr"), LoadOptions::default()).unwrap();
+    // Both put the top at their lowest z; compare the shapes relative to it.
+    let ((yb, zb), (yp, zp)) = (ban.lowest_z(), prr.lowest_z());
+    for k in -25..=25 {
+        let d = k as f64 * 1e-3;
+        let (a, b) = (ban.eval(yb + d).0 - zb, prr.eval(yp + d).0 - zp);
+        assert!((a - b).abs() < 0.05e-3, "rail at {d}: {a} vs {b}");
+    }
+    let wheel = load(&refdir.join("Car7216_0001r.whl"), LoadOptions::default()).unwrap();
+    let (lo, hi) = wheel.range();
+    assert!(lo < -0.05 && hi > 0.05, "flange and tread kept: {lo}..{hi}");
+    let geo = railforce::contact::WheelsetGeometry::new(wheel, prr, 0.0, 1.435, 1.360, 0.070, 0.42)
+        .unwrap();
+    let table = geo.table(0.02, 1e-4);
+    let l = table.equivalent_conicity(3e-3).unwrap();
+    assert!(l > 0.0 && l < 1.0, "{l}");
+    // Bad files.
+    let text = std::fs::read_to_string(refdir.join("MBench_UIC60_v3.ban")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let first_data = lines.iter().position(|l| l.trim().is_empty()).unwrap() + 1;
+    let mut jump = lines.clone();
+    let moved = format!(
+        "{} 99.0",
+        lines[first_data + 40].split_whitespace().next().unwrap()
+    );
+    jump[first_data + 40] = &moved;
+    let e = parse(
+        &jump.join("\n"),
+        std::path::Path::new("j.ban"),
+        LoadOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("j.ban") && e.contains("line") && e.contains("jump"),
+        "{e}"
+    );
+    let metres: String = (0..40)
+        .map(|i| {
+            format!(
+                "{} {}\n",
+                -0.03 + i as f64 * 0.0015,
+                0.001 * (i as f64 - 20.0).powi(2) / 400.0
+            )
+        })
+        .collect();
+    let e = parse(
+        &format!("ColumnDef=X,Y\n\n{metres}"),
+        std::path::Path::new("m.ban"),
+        LoadOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("m.ban") && e.contains("millimetres"), "{e}");
+}

@@ -199,6 +199,18 @@ fn profile_files_parse_or_say_why() {
         &[],
         |p| load(p, LoadOptions::default()),
     );
+    fuzz(
+        "profile-whl",
+        &root().join("assets/reference/profiles/Car7216_0001r.whl"),
+        &[],
+        |p| load(p, LoadOptions::default()),
+    );
+    fuzz(
+        "profile-ban",
+        &root().join("assets/reference/profiles/MBench_UIC60_v3.ban"),
+        &[],
+        |p| load(p, LoadOptions { mirror_y: true }),
+    );
 }
 
 #[test]

@@ -5,6 +5,7 @@ mod elastic;
 mod geometry;
 mod hertz;
 mod kalker;
+mod miniprof;
 pub mod profile;
 mod quasi_static;
 mod table;

@@ -380,7 +380,8 @@ pub struct LoadOptions {
     pub mirror_y: bool,
 }
 
-/// Reads a profile from a file: SIMPACK `.prw`/`.prr` (by extension) or a 2-column text/CSV
+/// Reads a profile from a file: SIMPACK `.prw`/`.prr`, MiniProf `.whl`/`.ban`/`.mpt` (by
+/// extension; see `contact::miniprof`) or a 2-column text/CSV
 /// file of `y, z` in mm (comments `#` or `!`, separators comma, semicolon, tab or spaces).
 /// The result follows the internal convention only if the file does (field side +y, z down);
 /// use [`LoadOptions::mirror_y`] otherwise.
@@ -399,6 +400,8 @@ pub fn parse(text: &str, path: &Path, opts: LoadOptions) -> Result<Profile> {
         .unwrap_or_default();
     let mut pts = if ext == "prw" || ext == "prr" {
         parse_simpack(&text, path)?
+    } else if super::miniprof::is_miniprof(&ext) {
+        super::miniprof::parse(&text, path, ext == "whl")?
     } else {
         parse_columns(&text, path)?
     };
