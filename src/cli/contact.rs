@@ -17,6 +17,12 @@ pub struct WheelsetArgs {
     /// Rail profile: `60kg` (CHN60/60E1 head) or a file (2-column y,z in mm, or SIMPACK .prr).
     #[arg(long, default_value = "60kg")]
     pub rail: String,
+    /// Mirror the wheel profile file's y (its field side to −y).
+    #[arg(long)]
+    pub mirror_wheel_y: bool,
+    /// Mirror the rail profile file's y (MiniProf rails are measured with the field side to −y).
+    #[arg(long)]
+    pub mirror_rail_y: bool,
     /// Rail inclination 1:N (0 when the rail profile is already inclined).
     #[arg(long, default_value_t = 40.0, value_name = "N")]
     pub inclination: f64,
@@ -49,8 +55,18 @@ impl WheelsetArgs {
             0.0
         };
         Ok(WheelsetGeometry::new(
-            profile::wheel_by_name_or_file(&self.wheel)?,
-            profile::rail_by_name_or_file(&self.rail)?,
+            profile::wheel_by_name_or_file(
+                &self.wheel,
+                profile::LoadOptions {
+                    mirror_y: self.mirror_wheel_y,
+                },
+            )?,
+            profile::rail_by_name_or_file(
+                &self.rail,
+                profile::LoadOptions {
+                    mirror_y: self.mirror_rail_y,
+                },
+            )?,
             incl,
             self.gauge_mm * 1e-3,
             self.flange_back_mm * 1e-3,

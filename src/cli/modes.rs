@@ -38,6 +38,9 @@ pub struct ModesArgs {
     /// e.g. vehicles/profiles/worn_heavy_haul_rail.csv.
     #[arg(long)]
     rail_profile: Option<String>,
+    /// Mirror the --rail-profile's y (MiniProf rails are measured with the field side to −y).
+    #[arg(long)]
+    mirror_rail_y: bool,
     /// Rail inclination 1:N of a --rail-profile (0 when it is already in track position).
     #[arg(long, default_value_t = 40.0, value_name = "N")]
     rail_inclination: f64,
@@ -75,6 +78,7 @@ pub fn run(args: ModesArgs) -> Result<()> {
     let mut vehicle = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&args.vehicle)?)?;
     if args.wheel_profile.is_some() || args.rail_profile.is_some() {
         let geo = &vehicle.contact.geometry;
+        let mirror = |m: bool| railforce::contact::profile::LoadOptions { mirror_y: m };
         let profile =
             |given: &Option<String>, own: &railforce::contact::Profile, wheel: bool| match given {
                 None => Ok(own.clone()),
@@ -83,9 +87,12 @@ pub fn run(args: ModesArgs) -> Result<()> {
                         .map(|p| p.to_string_lossy().into_owned())
                         .unwrap_or_else(|_| p.clone());
                     if wheel {
-                        railforce::contact::profile::wheel_by_name_or_file(&p)
+                        railforce::contact::profile::wheel_by_name_or_file(&p, mirror(false))
                     } else {
-                        railforce::contact::profile::rail_by_name_or_file(&p)
+                        railforce::contact::profile::rail_by_name_or_file(
+                            &p,
+                            mirror(args.mirror_rail_y),
+                        )
                     }
                 }
             };

@@ -356,20 +356,20 @@ pub fn rail_60kg() -> Profile {
     })
 }
 
-/// A wheel profile by name (`s1002`) or from a file (see [`load`]).
-pub fn wheel_by_name_or_file(spec: &str) -> Result<Profile> {
+/// A wheel profile by name (`s1002`) or from a file read with `opts` (see [`load`]).
+pub fn wheel_by_name_or_file(spec: &str, opts: LoadOptions) -> Result<Profile> {
     match spec.to_ascii_lowercase().as_str() {
         "s1002" => Ok(s1002()),
-        _ => load(Path::new(spec), LoadOptions::default()),
+        _ => load(Path::new(spec), opts),
     }
 }
 
 /// A rail profile by name (`60kg`, alias `chn60`, `60e1`, `uic60`: upright, to be inclined by
-/// the caller) or from a file (see [`load`]).
-pub fn rail_by_name_or_file(spec: &str) -> Result<Profile> {
+/// the caller) or from a file read with `opts` (see [`load`]).
+pub fn rail_by_name_or_file(spec: &str, opts: LoadOptions) -> Result<Profile> {
     match spec.to_ascii_lowercase().as_str() {
         "60kg" | "chn60" | "60e1" | "uic60" => Ok(rail_60kg()),
-        _ => load(Path::new(spec), LoadOptions::default()),
+        _ => load(Path::new(spec), opts),
     }
 }
 

@@ -71,6 +71,12 @@ struct ContactFile {
     /// Largest flange angle of the wheel profile, degrees (Nadal's limit).
     #[serde(default = "default_flange_angle")]
     flange_angle_deg: f64,
+    /// Mirror the wheel profile file's y (its field side to −y).
+    #[serde(default)]
+    wheel_profile_mirror_y: bool,
+    /// Mirror the rail profile file's y (MiniProf rails are measured with the field side to −y).
+    #[serde(default)]
+    rail_profile_mirror_y: bool,
 }
 
 fn default_tape_offset() -> f64 {
@@ -183,10 +189,15 @@ pub(super) fn load(path: &Path) -> Result<Vehicle> {
             spec.to_string()
         }
     };
-    let wheel = profile::wheel_by_name_or_file(&resolve(&c.wheel_profile))
-        .map_err(|e| cfg("contact.wheel_profile".into(), e.to_string()))?;
-    let rail = profile::rail_by_name_or_file(&resolve(&c.rail_profile))
-        .map_err(|e| cfg("contact.rail_profile".into(), e.to_string()))?;
+    let mirror = |m: bool| profile::LoadOptions { mirror_y: m };
+    let wheel = profile::wheel_by_name_or_file(
+        &resolve(&c.wheel_profile),
+        mirror(c.wheel_profile_mirror_y),
+    )
+    .map_err(|e| cfg("contact.wheel_profile".into(), e.to_string()))?;
+    let rail =
+        profile::rail_by_name_or_file(&resolve(&c.rail_profile), mirror(c.rail_profile_mirror_y))
+            .map_err(|e| cfg("contact.rail_profile".into(), e.to_string()))?;
     let inclination = if c.rail_inclination > 0.0 {
         (1.0 / c.rail_inclination).atan()
     } else {
