@@ -396,7 +396,7 @@ fn pairs(
     ];
     std::fs::create_dir_all(out)?;
     let mut csv = String::from(
-        "pair,flange_back_mm,conicity_3mm,stuck_kmh,stuck_mode,stuck_hz,sliding_kmh,sliding_mode,sliding_hz,kink_kmh,kink_hz,run_down_kmh,run_down_hz\n",
+        "pair,flange_back_mm,conicity_3mm,stuck_kmh,stuck_mode,stuck_hz,sliding_kmh,sliding_mode,sliding_hz,kink_kmh,kink_hz,run_down_kmh,run_down_hz,run_down_sigma_y_rms_kn,run_down_sigma_y_limit_kn\n",
     );
     let mut rows = Vec::new();
     let mut pts: [Vec<(f64, f64)>; 4] = Default::default();
@@ -444,6 +444,9 @@ fn pairs(
             non(&c.run_down),
             t0.elapsed().as_secs_f64(),
         );
+        let en = |n: &Option<railforce::sim::modes::Nonlinear>| {
+            n.as_ref().and_then(|n| n.running_stability_kn)
+        };
         let kmh =
             |c: &Option<railforce::sim::modes::Critical>| c.as_ref().and_then(|c| c.speed_kmh);
         let hz = |c: &Option<railforce::sim::modes::Critical>| c.as_ref().map(|c| c.frequency_hz);
@@ -455,7 +458,7 @@ fn pairs(
         let nf =
             |n: &Option<railforce::sim::modes::Nonlinear>| n.as_ref().and_then(|n| n.frequency_hz);
         csv += &format!(
-            "{name},{:.1},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{name},{:.1},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             c.flange_back_m * 1e3,
             c.conicity.map_or(String::new(), |l| format!("{l:.4}")),
             opt(kmh(&c.stuck)),
@@ -468,6 +471,8 @@ fn pairs(
             opt(nf(&c.kink_and_coast)),
             opt(nk(&c.run_down)),
             opt(nf(&c.run_down)),
+            opt(en(&c.run_down).map(|e| e.0)),
+            opt(en(&c.run_down).map(|e| e.1)),
         );
         if let Some(l) = c.conicity {
             for (k, v) in [

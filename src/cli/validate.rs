@@ -341,16 +341,19 @@ fn fidelity(
                 } else {
                     format!("kicked {} m/s, 1.5 m/s²", fd::RUN_DOWN_KICK)
                 };
+                let en = n.running_stability_kn.map_or(String::new(), |(v, l)| {
+                    format!("; running stability (ΣY)rms {v:.1} kN of {l:.1} kN")
+                });
                 match n.critical_kmh {
                     Some(s) => println!(
-                        "    {method} from {:.0} km/h ({how}), {}: hunting dies out at {s:.0} km/h{}",
+                        "    {method} from {:.0} km/h ({how}), {}: hunting dies out at {s:.0} km/h{}{en}",
                         from * 3.6,
                         r.vehicle,
                         n.frequency_hz
                             .map_or(String::new(), |f| format!(", limit cycle {f:.2} Hz there"))
                     ),
                     None => println!(
-                        "    {method} from {:.0} km/h ({how}), {}: no hunting",
+                        "    {method} from {:.0} km/h ({how}), {}: no hunting{en}",
                         from * 3.6,
                         r.vehicle
                     ),

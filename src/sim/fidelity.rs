@@ -33,6 +33,9 @@ pub struct CriticalSpeed {
     /// Frequency of the leading wheelset's lateral motion at each block, over the 3 s ending
     /// with it (crossings of its mean), Hz; 0 where it crossed fewer than twice.
     pub frequencies: Vec<f64>,
+    /// Every wheel's Y and Q and the track position at 200 Hz (sampled, not filtered): what
+    /// the acceptance statistics judge ([`crate::assess`], running stability).
+    pub forces: crate::assess::RunForces,
 }
 
 impl CriticalSpeed {
@@ -139,6 +142,23 @@ fn coast(
     let mut frequencies = Vec::new();
     let mut block = Vec::with_capacity(steps_per_block);
     let mut window: Vec<f64> = Vec::new();
+    let n_wheels = 2 * vehicle.contact.wheelsets.len();
+    let mut forces = crate::assess::RunForces {
+        time: Vec::new(),
+        s: Vec::new(),
+        wheels: (0..n_wheels)
+            .map(|k| crate::assess::WheelSeries {
+                wheel: format!("w{}", crate::vehicle::wheel_name(k).to_ascii_lowercase()),
+                y: Vec::new(),
+                q: Vec::new(),
+            })
+            .collect(),
+        carbody: None,
+    };
+    let every = (1.0 / (crate::sensors::RATE_HZ * sim.config().dt))
+        .round()
+        .max(1.0) as usize;
+    let mut step = 0usize;
     let mut kick = kick;
     while sim.time() < duration {
         let t = sim.time();
@@ -161,6 +181,15 @@ fn coast(
         sim.set_speed(v);
         sim.step()?;
         block.push(sim.wheels[2 * lead].y_centre);
+        if step.is_multiple_of(every) {
+            forces.time.push(sim.time());
+            forces.s.push(sim.body_s()[vehicle.contact.wheelsets[0]]);
+            for (w, r) in forces.wheels.iter_mut().zip(&sim.wheels) {
+                w.y.push(r.y);
+                w.q.push(r.q);
+            }
+        }
+        step += 1;
         if block.len() == steps_per_block {
             let (lo, hi) = block
                 .iter()
@@ -189,6 +218,7 @@ fn coast(
         critical,
         blocks,
         frequencies,
+        forces,
     })
 }
 

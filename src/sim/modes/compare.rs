@@ -10,6 +10,10 @@ use crate::track::Track;
 use crate::vehicle::Vehicle;
 use serde::Serialize;
 
+/// Seconds at the start of a nonlinear run left out of its running-stability criterion: the
+/// kink and the kick (at 0.5 s) and their first response.
+const TRANSIENT_S: f64 = 3.0;
+
 /// A nonlinear method's verdict.
 #[derive(Debug, Clone, Serialize)]
 pub struct Nonlinear {
@@ -19,11 +23,51 @@ pub struct Nonlinear {
     pub frequency_hz: Option<f64>,
     /// Speed (km/h) and half peak-to-peak amplitude of the leading wheelset (mm) per second.
     pub amplitude_mm: Vec<(f64, f64)>,
+    /// The EN 14363-style running-stability criterion on the run (`assess`: ΣY of each
+    /// wheelset band-passed around its dominant frequency, the largest sliding rms over 100 m,
+    /// against its share of the track-shifting limit), after the first 3 s: the worst
+    /// wheelset's value and limit, kN (`None` when the run is shorter than the criterion's
+    /// window).
+    pub running_stability_kn: Option<(f64, f64)>,
 }
 
-impl From<&CriticalSpeed> for Nonlinear {
-    fn from(c: &CriticalSpeed) -> Self {
+impl Nonlinear {
+    /// The verdict of one method's run, with the running-stability criterion on its forces
+    /// for the static wheel load `q0_kn`.
+    fn of(c: &CriticalSpeed, q0_kn: f64) -> Self {
+        let criteria = crate::assess::Criteria::builtin();
+        // The kink's and the kick's own transient (the first 3 s) is not the running.
+        let f = &c.forces;
+        let from = f
+            .time
+            .iter()
+            .position(|&t| t >= TRANSIENT_S)
+            .unwrap_or(f.time.len());
+        let running = crate::assess::RunForces {
+            time: f.time[from..].to_vec(),
+            s: f.s[from..].to_vec(),
+            wheels: f
+                .wheels
+                .iter()
+                .map(|w| crate::assess::WheelSeries {
+                    wheel: w.wheel.clone(),
+                    y: w.y[from..].to_vec(),
+                    q: w.q[from..].to_vec(),
+                })
+                .collect(),
+            carbody: None,
+        };
+        let running_stability_kn = crate::assess::assess(&running, &[], &criteria, q0_kn)
+            .ok()
+            .and_then(|a| {
+                a.rows
+                    .into_iter()
+                    .filter(|r| r.criterion == "stability")
+                    .max_by(|x, y| (x.value / x.limit).total_cmp(&(y.value / y.limit)))
+                    .map(|r| (r.value, r.limit))
+            });
         Nonlinear {
+            running_stability_kn,
             critical_kmh: c.critical.map(|v| v * 3.6),
             frequency_hz: c.cycle_frequency(),
             amplitude_mm: c
@@ -93,10 +137,14 @@ pub fn compare(
     );
     let (kink, down) = if nonlinear {
         (
-            Some(Nonlinear::from(&critical_speed(
-                vehicle, track, from, to, 2.0,
-            )?)),
-            Some(Nonlinear::from(&run_down(vehicle, track, from, to, 1.5)?)),
+            Some(Nonlinear::of(
+                &critical_speed(vehicle, track, from, to, 2.0)?,
+                vehicle.static_wheel_load_kn(),
+            )),
+            Some(Nonlinear::of(
+                &run_down(vehicle, track, from, to, 1.5)?,
+                vehicle.static_wheel_load_kn(),
+            )),
         )
     } else {
         (None, None)
