@@ -296,51 +296,35 @@ fn bifurcation(
     speeds: &[f64],
     out: &std::path::Path,
 ) -> Result<serde_json::Value> {
-    use railforce::sim::fidelity as fd;
-    let (from, to) = (speeds[speeds.len() - 1], speeds[0].max(50.0 / 3.6));
-    let runs = [
-        (
-            "kink-and-coast",
-            fd::critical_speed(vehicle, track, from, to, 2.0)?,
-        ),
-        ("run-down", fd::run_down(vehicle, track, from, to, 1.5)?),
-    ];
+    let runs = railforce::sim::modes::nonlinear_views(vehicle, track, speeds)?;
     let mut csv = String::from("method,speed_kmh,amplitude_mm,frequency_hz\n");
     let mut series = Vec::new();
     let mut json = serde_json::Map::new();
     println!(
         "nonlinear, smooth tangent from {:.0} to {:.0} km/h:",
-        from * 3.6,
-        to * 3.6
+        speeds[speeds.len() - 1] * 3.6,
+        (speeds[0] * 3.6).max(50.0)
     );
-    for (name, run) in &runs {
-        let pts: Vec<(f64, f64)> = run
-            .blocks
-            .iter()
-            .skip(2)
-            .map(|(v, a)| (v * 3.6, a * 1e3))
-            .collect();
-        for ((v, a), f) in run.blocks.iter().zip(&run.frequencies).skip(2) {
-            csv += &format!("{name},{:.2},{:.3},{:.3}\n", v * 3.6, a * 1e3, f);
+    for (name, run) in ["kink-and-coast", "run-down"].iter().zip(&runs) {
+        for (v, a, f) in &run.blocks {
+            csv += &format!("{name},{v:.2},{a:.3},{f:.3}\n");
         }
-        series.push(Series::points(name.to_string(), pts));
-        let (crit, freq) = (run.critical, run.cycle_frequency());
+        series.push(Series::points(
+            name.to_string(),
+            run.blocks.iter().map(|b| (b.0, b.1)).collect(),
+        ));
         println!(
             "  {name:<16} {}",
-            match (crit, freq) {
+            match (run.critical_kmh, run.frequency_hz) {
                 (Some(c), Some(f)) => format!(
-                    "hunting (≥ {:.1} mm) down to {:.0} km/h, limit cycle {f:.2} Hz there",
-                    fd::HUNTING_AMPLITUDE * 1e3,
-                    c * 3.6
+                    "hunting (≥ {:.1} mm) down to {c:.0} km/h, limit cycle {f:.2} Hz there",
+                    railforce::sim::fidelity::HUNTING_AMPLITUDE * 1e3
                 ),
-                (Some(c), None) => format!("hunting down to {:.0} km/h", c * 3.6),
+                (Some(c), None) => format!("hunting down to {c:.0} km/h"),
                 _ => "no hunting".into(),
             }
         );
-        json.insert(
-            name.to_string(),
-            serde_json::json!({"critical_kmh": crit.map(|c| c * 3.6), "cycle_frequency_hz": freq}),
-        );
+        json.insert(name.to_string(), serde_json::to_value(run)?);
     }
     let write = |name: &str, text: &str| {
         railforce::io::write_atomic(&out.join(name), |w| w.write_all(text.as_bytes()))

@@ -359,7 +359,7 @@ fn fidelity(
                     ),
                 }
                 if std::env::var_os("RAILFORCE_VERBOSE").is_some() {
-                    for (v, a) in &n.amplitude_mm {
+                    for (v, a, _) in &n.blocks {
                         eprintln!("      {v:.0} km/h: {a:.2} mm");
                     }
                 }

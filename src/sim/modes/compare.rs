@@ -21,8 +21,9 @@ pub struct Nonlinear {
     pub critical_kmh: Option<f64>,
     /// Frequency of the limit cycle there, Hz.
     pub frequency_hz: Option<f64>,
-    /// Speed (km/h) and half peak-to-peak amplitude of the leading wheelset (mm) per second.
-    pub amplitude_mm: Vec<(f64, f64)>,
+    /// Per second after the first two: speed (km/h), half peak-to-peak amplitude of the
+    /// leading wheelset (mm) and its frequency over the 3 s ending there (Hz).
+    pub blocks: Vec<(f64, f64, f64)>,
     /// The EN 14363-style running-stability criterion on the run (`assess`: ΣY of each
     /// wheelset band-passed around its dominant frequency, the largest sliding rms over 100 m,
     /// against its share of the track-shifting limit), after the first 3 s: the worst
@@ -70,11 +71,12 @@ impl Nonlinear {
             running_stability_kn,
             critical_kmh: c.critical.map(|v| v * 3.6),
             frequency_hz: c.cycle_frequency(),
-            amplitude_mm: c
+            blocks: c
                 .blocks
                 .iter()
+                .zip(&c.frequencies)
                 .skip(2)
-                .map(|(v, a)| (v * 3.6, a * 1e3))
+                .map(|((v, a), f)| (v * 3.6, a * 1e3, *f))
                 .collect(),
         }
     }
@@ -127,25 +129,9 @@ pub fn compare(
                     .total_cmp(&b.speed_kmh.unwrap_or(f64::INFINITY))
             }))
     };
-    let (from, to) = (
-        speeds.last().copied().unwrap_or(200.0 / 3.6),
-        speeds
-            .first()
-            .copied()
-            .unwrap_or(50.0 / 3.6)
-            .max(50.0 / 3.6),
-    );
     let (kink, down) = if nonlinear {
-        (
-            Some(Nonlinear::of(
-                &critical_speed(vehicle, track, from, to, 2.0)?,
-                vehicle.static_wheel_load_kn(),
-            )),
-            Some(Nonlinear::of(
-                &run_down(vehicle, track, from, to, 1.5)?,
-                vehicle.static_wheel_load_kn(),
-            )),
-        )
+        let [k, d] = nonlinear_views(vehicle, track, speeds)?;
+        (Some(k), Some(d))
     } else {
         (None, None)
     };
@@ -158,4 +144,21 @@ pub fn compare(
         kink_and_coast: kink,
         run_down: down,
     })
+}
+
+/// Kink-and-coast (6 mm kink, 2 m/s²) and the run-down (kicked at the top speed, 1.5 m/s²) of
+/// `vehicle` on the smooth `track`, from the highest of `speeds` (m/s) down to the lowest, at
+/// least 50 km/h: the two branches of the bifurcation.
+pub fn nonlinear_views(vehicle: &Vehicle, track: &Track, speeds: &[f64]) -> Result<[Nonlinear; 2]> {
+    let from = speeds.last().copied().unwrap_or(200.0 / 3.6);
+    let to = speeds
+        .first()
+        .copied()
+        .unwrap_or(50.0 / 3.6)
+        .max(50.0 / 3.6);
+    let q0 = vehicle.static_wheel_load_kn();
+    Ok([
+        Nonlinear::of(&critical_speed(vehicle, track, from, to, 2.0)?, q0),
+        Nonlinear::of(&run_down(vehicle, track, from, to, 1.5)?, q0),
+    ])
 }

@@ -270,6 +270,6 @@ mod eigen;
 mod linear;
 mod naming;
 
-pub use compare::{Comparison, Nonlinear, compare};
+pub use compare::{Comparison, Nonlinear, compare, nonlinear_views};
 
 use linear::Linear;
