@@ -22,9 +22,11 @@ pub struct ModesArgs {
     /// equivalent conicity at this amplitude, with the contact-angle and gravitational terms).
     #[arg(long, default_value_t = 3.0)]
     amplitude_mm: f64,
-    /// Friction elements stuck (their stick springs), sliding (no friction force) or both
-    /// (two loci).
-    #[arg(long, default_value = "both", value_parser = ["stuck", "sliding", "both"])]
+    /// Friction elements stuck (their stick springs), sliding (no friction force), both (two
+    /// loci), equivalent (each by its describing function over the least damped mode's cycle
+    /// with the first wheelset at --amplitude-mm: the friction of a limit cycle of that size)
+    /// or all three.
+    #[arg(long, default_value = "both", value_parser = ["stuck", "sliding", "both", "equivalent", "all"])]
     friction: String,
     /// Change the wheelsets' flange back-to-back distance by this many mm (S1002's conicity
     /// turns with it: +7 mm takes the C80's 1 353 mm to S1002's design 1 360 mm).
@@ -130,6 +132,12 @@ pub fn run(args: ModesArgs) -> Result<()> {
     let limits: Vec<FrictionLimit> = match args.friction.as_str() {
         "stuck" => vec![FrictionLimit::Stuck],
         "sliding" => vec![FrictionLimit::Sliding],
+        "equivalent" => vec![FrictionLimit::Equivalent],
+        "all" => vec![
+            FrictionLimit::Stuck,
+            FrictionLimit::Sliding,
+            FrictionLimit::Equivalent,
+        ],
         _ => vec![FrictionLimit::Stuck, FrictionLimit::Sliding],
     };
     let amplitude = args.amplitude_mm * 1e-3;
@@ -315,12 +323,12 @@ fn bifurcation(
         ));
         println!(
             "  {name:<16} {}",
-            match (run.critical_kmh, run.frequency_hz) {
-                (Some(c), Some(f)) => format!(
-                    "hunting (≥ {:.1} mm) down to {c:.0} km/h, limit cycle {f:.2} Hz there",
+            match (run.critical_kmh, run.frequency_hz, run.cycle_kmh) {
+                (Some(c), Some(f), Some(at)) => format!(
+                    "hunting (≥ {:.1} mm) down to {c:.0} km/h, limit cycle {f:.2} Hz at {at:.0} km/h (the lowest speed it held its amplitude)",
                     railforce::sim::fidelity::HUNTING_AMPLITUDE * 1e3
                 ),
-                (Some(c), None) => format!("hunting down to {c:.0} km/h"),
+                (Some(c), _, _) => format!("hunting down to {c:.0} km/h"),
                 _ => "no hunting".into(),
             }
         );

@@ -235,8 +235,11 @@ pub fn klingel(
 pub struct WickensCheck {
     /// Critical speed found by simulation (bisection on growth or decay of a perturbation), m/s.
     pub measured: f64,
-    /// `sqrt((r0·b0/λe)·(k_ψ + b0²·k_y)/(m·b0² + I_z))`, m/s.
+    /// Wickens' closed form with the wheelset's gyroscopic yaw moment,
+    /// `sqrt((r0·b0/λe)·(k_ψ + b0²·k_y)/(m·b0² + I_z − I_y))`, m/s (see [`wickens`]).
     pub expected: f64,
+    /// The textbook form without it, `sqrt((r0·b0/λe)·(k_ψ + b0²·k_y)/(m·b0² + I_z))`, m/s.
+    pub textbook: f64,
     /// Equivalent conicity used, at the perturbation's amplitude.
     pub conicity: f64,
 }
@@ -272,6 +275,15 @@ fn grows(vehicle: &Vehicle, speed: f64, amplitude: f64, seconds: f64) -> Result<
 
 /// Finds the critical speed of a restrained single wheelset (`vehicle` with one wheelset and a
 /// `track_spring`) by bisection between half and twice Wickens' value, and compares.
+///
+/// The closed form: Wickens' two equations of the wheelset (lateral `y`, yaw `ψ`, equal creep
+/// coefficients `f`, large against the springs) with the gyroscopic yaw moment of the spinning
+/// wheelset, `I_y·(V/r0)·φ̇` with its kinematic roll `φ = λ·y/b0` (assets/docs/stability.md).
+/// At the stability boundary `s = iω` the real part gives `ω² = V²·λ/(r0·b0)` and the imaginary
+/// part `ω² = (k_ψ + b0²·k_y)/(m·b0² + I_z − I_y)`: the spin's moment of inertia takes `I_y`
+/// off the yaw inertia. Without it (the textbook form) the critical speed is 4–5 % lower for
+/// a wheelset with `I_y/I_z` ≈ 0.17; the model without spin inertia meets that form
+/// (tests/stability.rs).
 pub fn wickens(vehicle: &Vehicle) -> Result<WickensCheck> {
     let (ky, kpsi) = vehicle
         .elements
@@ -290,8 +302,10 @@ pub fn wickens(vehicle: &Vehicle) -> Result<WickensCheck> {
     let conicity = table.equivalent_conicity(amplitude).ok_or_else(|| {
         crate::Error::Domain("no kinematic oscillation in the contact table".into())
     })?;
-    let expected =
-        ((r0 * b0 / conicity) * (kpsi + b0 * b0 * ky) / (ws.mass * b0 * b0 + ws.inertia.z)).sqrt();
+    let closed = |yaw_inertia: f64| {
+        ((r0 * b0 / conicity) * (kpsi + b0 * b0 * ky) / (ws.mass * b0 * b0 + yaw_inertia)).sqrt()
+    };
+    let (expected, textbook) = (closed(ws.inertia.z - ws.inertia.y), closed(ws.inertia.z));
     let (mut lo, mut hi) = (0.5 * expected, 2.0 * expected);
     for _ in 0..10 {
         let mid = 0.5 * (lo + hi);
@@ -304,6 +318,7 @@ pub fn wickens(vehicle: &Vehicle) -> Result<WickensCheck> {
     Ok(WickensCheck {
         measured: 0.5 * (lo + hi),
         expected,
+        textbook,
         conicity,
     })
 }

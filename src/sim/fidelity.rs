@@ -39,20 +39,34 @@ pub struct CriticalSpeed {
 }
 
 impl CriticalSpeed {
-    /// Frequency of the limit cycle where it last survived (the block at the critical
-    /// speed), Hz.
-    pub fn cycle_frequency(&self) -> Option<f64> {
-        let c = self.critical?;
-        self.blocks
+    /// Frequency of the limit cycle at the lowest speed where it still held its amplitude,
+    /// Hz: the last block of the hunting (≥ 1.5 mm) whose amplitude is within
+    /// [`CYCLE_HOLD`] of the block before it. A limit cycle keeps its amplitude from second to
+    /// second as the speed falls (by 1–3 % on the C80's branch); the blocks after it are its
+    /// collapse, whose frequency is a decaying transient's (the loaded C80's run-down: 1.97 Hz
+    /// at 103 km/h on the cycle, 1.58 Hz in the collapse at 92 km/h).
+    /// Returns the block's speed (m/s) and the frequency.
+    pub fn cycle_frequency(&self) -> Option<(f64, f64)> {
+        self.critical?;
+        let hunting: Vec<(f64, f64, f64)> = self
+            .blocks
             .iter()
             .zip(&self.frequencies)
             .skip(2)
             .take_while(|(b, _)| b.1 >= HUNTING_AMPLITUDE)
-            .filter(|(b, _)| b.0 <= c + 1e-9)
-            .map(|(_, f)| *f)
-            .last()
+            .map(|(b, f)| (b.0, b.1, *f))
+            .collect();
+        hunting
+            .windows(2)
+            .rfind(|w| w[1].1 >= (1.0 - CYCLE_HOLD) * w[0].1)
+            .map(|w| (w[1].0, w[1].2))
+            .or(hunting.last().map(|h| (h.0, h.2)))
     }
 }
+
+/// How much a limit cycle's amplitude may fall from one 1 s block to the next and still be
+/// the cycle rather than its collapse.
+pub const CYCLE_HOLD: f64 = 0.10;
 
 /// Half peak-to-peak lateral amplitude of the leading wheelset over a 1 s block from which a
 /// wagon is said to hunt, m.
@@ -393,4 +407,44 @@ pub fn position_jitter(s: &[f64]) -> f64 {
     s.windows(3)
         .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
         .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cycle's frequency is read where it last held its amplitude, not in its collapse (the
+    /// loaded C80's run-down, 2026-12-02: 6.82 → 5.63 → 2.85 mm).
+    #[test]
+    fn cycle_frequency_is_read_where_the_cycle_holds() {
+        let kmh = |v: f64| v / 3.6;
+        let c = CriticalSpeed {
+            critical: Some(kmh(92.0)),
+            blocks: vec![
+                (kmh(200.0), 5.0e-3), // the first two blocks are the kick
+                (kmh(195.0), 5.0e-3),
+                (kmh(108.2), 6.84e-3),
+                (kmh(102.8), 6.82e-3),
+                (kmh(97.4), 5.63e-3),
+                (kmh(92.0), 2.85e-3),
+                (kmh(86.6), 0.85e-3),
+            ],
+            frequencies: vec![2.6, 2.6, 2.00, 1.97, 1.84, 1.58, 1.2],
+            forces: crate::assess::RunForces {
+                time: vec![],
+                s: vec![],
+                wheels: vec![],
+                carbody: None,
+            },
+        };
+        let (v, f) = c.cycle_frequency().unwrap();
+        assert!((v * 3.6 - 102.8).abs() < 1e-9 && f == 1.97, "{v} {f}");
+        // A cycle seen in one block only is read there.
+        let one = CriticalSpeed {
+            blocks: c.blocks[..3].to_vec(),
+            frequencies: c.frequencies[..3].to_vec(),
+            ..c.clone()
+        };
+        assert_eq!(one.cycle_frequency().unwrap().1, 2.00);
+    }
 }

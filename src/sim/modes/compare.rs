@@ -19,8 +19,11 @@ const TRANSIENT_S: f64 = 3.0;
 pub struct Nonlinear {
     /// Lowest speed at which the hunting cycle survived, km/h (`None`: no hunting).
     pub critical_kmh: Option<f64>,
-    /// Frequency of the limit cycle there, Hz.
+    /// Frequency of the limit cycle at the lowest speed where it held its amplitude, Hz
+    /// ([`CriticalSpeed::cycle_frequency`]).
     pub frequency_hz: Option<f64>,
+    /// That speed, km/h.
+    pub cycle_kmh: Option<f64>,
     /// Per second after the first two: speed (km/h), half peak-to-peak amplitude of the
     /// leading wheelset (mm) and its frequency over the 3 s ending there (Hz).
     pub blocks: Vec<(f64, f64, f64)>,
@@ -70,7 +73,8 @@ impl Nonlinear {
         Nonlinear {
             running_stability_kn,
             critical_kmh: c.critical.map(|v| v * 3.6),
-            frequency_hz: c.cycle_frequency(),
+            frequency_hz: c.cycle_frequency().map(|c| c.1),
+            cycle_kmh: c.cycle_frequency().map(|c| c.0 * 3.6),
             blocks: c
                 .blocks
                 .iter()

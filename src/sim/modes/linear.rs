@@ -289,6 +289,65 @@ impl<'a> Linear<'a> {
         Ok(a)
     }
 
+    /// The first harmonic of the wrench `element` (the vehicle's element `index`) puts on every
+    /// body (force, torque per body, world axes) while the state moves through
+    /// `Re(scale·shape·e^{iθ})`: a first cycle from the reference's memory brings its sliders
+    /// onto the steady hysteresis loop, the second is measured (`F̂ = (1/π)∫F·e^{−iθ}dθ`).
+    pub(super) fn element_harmonic(
+        &mut self,
+        element: &crate::vehicle::Element,
+        index: usize,
+        shape: &DVector<Complex<f64>>,
+        scale: f64,
+    ) -> DVector<Complex<f64>> {
+        const STEPS: usize = 128;
+        let nb = self.bodies();
+        let mut memory = self.memory[index];
+        let mut h = DVector::zeros(6 * nb);
+        for k in 0..2 * STEPS {
+            let turn =
+                Complex::from_polar(scale, 2.0 * std::f64::consts::PI * k as f64 / STEPS as f64);
+            let x = shape.map(|v| (v * turn).re);
+            self.set(&x);
+            let mut wrenches = vec![crate::vehicle::Wrench::default(); nb];
+            element.apply(&self.sim.states, &mut memory, &mut wrenches);
+            if k >= STEPS {
+                let e = super::describing::harmonic_weight(k, STEPS);
+                for (i, w) in wrenches.iter().enumerate() {
+                    for j in 0..3 {
+                        h[6 * i + j] += e * w.force[j];
+                        h[6 * i + 3 + j] += e * w.torque[j];
+                    }
+                }
+            }
+        }
+        h
+    }
+
+    /// The eigenvalue of `a` below `max_frequency` with the least damping ratio, and its
+    /// eigenvector.
+    pub(super) fn least_damped(
+        &self,
+        a: &DMatrix<f64>,
+        max_frequency: f64,
+    ) -> Option<(Complex<f64>, DVector<Complex<f64>>)> {
+        let wmax = 2.0 * std::f64::consts::PI * max_frequency;
+        let l = a
+            .clone()
+            .complex_eigenvalues()
+            .iter()
+            .copied()
+            .filter(|l| l.im > 1e-3 && l.im <= wmax && l.norm() > 1e-6)
+            .max_by(|a, b| (a.re / a.norm()).total_cmp(&(b.re / b.norm())))?;
+        let (q, h) = nalgebra::linalg::Hessenberg::new(a.clone()).unpack();
+        Some((l, eigenvector(&q, &h, l)))
+    }
+
+    /// Index of the lateral displacement of the vehicle's first wheelset in the state.
+    pub(super) fn leading_lateral(&self) -> usize {
+        12 * self.sim.vehicle.contact.wheelsets[0] + 1
+    }
+
     /// Eigenvalues and named modes of `a` below `max_frequency`.
     pub(super) fn analyse(&self, a: &DMatrix<f64>, max_frequency: f64) -> Vec<Mode> {
         let eig = a.clone().complex_eigenvalues();

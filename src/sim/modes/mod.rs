@@ -32,6 +32,10 @@ pub enum FrictionLimit {
     Stuck,
     /// Friction sliding: no friction force (its friction coefficients set to zero).
     Sliding,
+    /// Each friction element by its describing function over the least damped mode's cycle at
+    /// the contact's amplitude: the stiffness and damping of its first harmonic, between the
+    /// two limits (`sim/modes/describing.rs`).
+    Equivalent,
 }
 
 impl FrictionLimit {
@@ -40,6 +44,7 @@ impl FrictionLimit {
         match self {
             FrictionLimit::Stuck => "stuck",
             FrictionLimit::Sliding => "sliding",
+            FrictionLimit::Equivalent => "equivalent",
         }
     }
 }
@@ -160,7 +165,18 @@ pub fn modes(vehicle: &Vehicle, track: &Track, opts: &ModesOptions) -> Result<Ve
             let mut lin = Linear::new(sim);
             lin.equilibrate();
             let residual = lin.residual();
-            let a = lin.jacobian(opts.amplitude)?;
+            let a = if opts.friction == FrictionLimit::Equivalent {
+                describing::equivalent_matrix(
+                    &mut lin,
+                    &v,
+                    track,
+                    speed,
+                    opts.amplitude,
+                    opts.max_frequency,
+                )?
+            } else {
+                lin.jacobian(opts.amplitude)?
+            };
             let modes = lin.analyse(&a, opts.max_frequency);
             Ok(SpeedModes {
                 speed_kmh: speed * 3.6,
@@ -266,6 +282,7 @@ pub fn critical_speeds(sweep: &[SpeedModes]) -> Vec<Critical> {
 }
 
 mod compare;
+mod describing;
 mod eigen;
 mod linear;
 mod naming;
