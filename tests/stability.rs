@@ -254,3 +254,37 @@ fn equivalent_friction_sticks_at_small_amplitude_and_damps_on_the_cycle() {
         "on the cycle: equivalent ζ {ze}, stuck ζ {zs}"
     );
 }
+
+/// `railforce modes --nonlinear` draws one bifurcation chart with both branches: kink-and-coast
+/// and the run-down, each a series of amplitudes against speed in the CSV and on the SVG.
+#[test]
+fn bifurcation_chart_has_both_branches() {
+    let dir = std::env::temp_dir().join(format!("railforce-bif-{}", std::process::id()));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["modes", "--vehicle", "c80", "--speeds", "150:200:50"])
+        .args(["--friction", "stuck", "--nonlinear", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("bifurcation.csv")).unwrap();
+    let svg = std::fs::read_to_string(dir.join("bifurcation.svg")).unwrap();
+    for branch in ["kink-and-coast", "run-down"] {
+        let rows: Vec<Vec<f64>> = csv
+            .lines()
+            .filter(|l| l.starts_with(branch))
+            .map(|l| l.split(',').skip(1).map(|v| v.parse().unwrap()).collect())
+            .collect();
+        assert!(rows.len() >= 10, "{branch}: {} rows", rows.len());
+        // Speeds fall from the top of the sweep; the loaded wagon hunts there (5–7 mm).
+        assert!(rows.iter().all(|r| (149.0..=200.5).contains(&r[0])));
+        assert!(rows.iter().any(|r| r[1] > 3.0), "{branch}: no cycle");
+        assert!(svg.contains(branch), "{branch} missing from the chart");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
