@@ -510,3 +510,81 @@ fn gauge_stays_within_its_class_limits() {
     assert!(((b - a) / 2e-9 - 1.0).abs() < 1e-3);
     assert!(soft_limit(-1.0, -12.7e-3, 1.0) >= -12.7e-3);
 }
+
+/// The German spectra (`irregularity.spectrum = "german_low"` / `"german_high"`): the PSD is
+/// the published form with its coefficients, written out here independently, and the
+/// synthesised samples carry the formula's RMS (within 3 % averaged over four seeds).
+#[test]
+fn german_spectra_follow_the_published_form() {
+    let (wc, wr, ws, b) = (0.8246f64, 0.0206f64, 0.4380f64, 0.75f64);
+    for (name, av, aa, ag) in [
+        ("german_low", 4.032e-7, 2.119e-7, 5.32e-8),
+        ("german_high", 1.080e-6, 6.125e-7, 1.032e-7),
+    ] {
+        let length = 10_000.0;
+        let text = |seed: u64| {
+            format!(
+                "[[section]]\nkind = \"tangent\"\nlength_m = {length}\n[irregularity]\nclass = 5\nspectrum = \"{name}\"\nseed = {seed}\n"
+            )
+        };
+        let spec = TrackSpec::parse(&text(1), Path::new("mem.toml")).unwrap();
+        let irr = spec.irregularity.unwrap();
+        for w in [0.05f64, 0.3, 1.0, 4.0] {
+            let base = av * wc * wc / ((w * w + wr * wr) * (w * w + wc * wc));
+            let twist =
+                wc * wc * w * w / ((w * w + wr * wr) * (w * w + wc * wc) * (w * w + ws * ws));
+            let want = [
+                base,
+                base * aa / av,
+                (av / (b * b)) * twist * (2.0 * b) * (2.0 * b),
+                ag * twist,
+            ];
+            for (ch, want) in Channel::ALL.into_iter().zip(want) {
+                let got = irr.psd(ch, w);
+                assert!(
+                    (got / want - 1.0).abs() < 1e-12,
+                    "{name} {} at {w}: {got} vs {want}",
+                    ch.name()
+                );
+            }
+        }
+        let mut sum = [0.0; 4];
+        for seed in 1..=4 {
+            let t = Track::new(
+                TrackSpec::parse(&text(seed), Path::new("mem.toml")).unwrap(),
+                None,
+            );
+            for (i, c) in check::rms_checks(t.irregularities().unwrap(), length)
+                .iter()
+                .enumerate()
+            {
+                sum[i] += c.sample_rms / 4.0;
+                if seed == 1 {
+                    assert!((c.formula_rms / irr.band_rms(c.channel) - 1.0).abs() < 1e-12);
+                }
+            }
+        }
+        for (i, ch) in Channel::ALL.into_iter().enumerate() {
+            // The gauge is held inside the class's limits; the others are not bent.
+            if ch == Channel::Gauge {
+                continue;
+            }
+            let want = irr.band_rms(ch);
+            assert!(
+                (sum[i] / want - 1.0).abs() < 0.03,
+                "{name} {}: {} vs {want}",
+                ch.name(),
+                sum[i]
+            );
+        }
+    }
+    // An unknown spectrum is named in the error.
+    let bad = "[[section]]\nkind = \"tangent\"\nlength_m = 100\n[irregularity]\nclass = 5\nspectrum = \"chinese\"\n";
+    let e = TrackSpec::parse(bad, Path::new("bad.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("irregularity.spectrum") && e.contains("german_high"),
+        "{e}"
+    );
+}

@@ -46,8 +46,11 @@ pub fn run(args: TrackArgs) -> Result<()> {
         })?;
         let sp = irr.spec();
         println!(
-            "\nIrregularity RMS, FRA class {}, band {}–{} m, seed {}, over {:.0} m:",
-            sp.class.number,
+            "\nIrregularity RMS, {}, band {}–{} m, seed {}, over {:.0} m:",
+            match sp.spectrum {
+                railforce::track::Spectrum::Fra => format!("FRA class {}", sp.class.number),
+                s => format!("spectrum {}", s.name()),
+            },
             sp.min_wavelength,
             sp.max_wavelength,
             sp.seed,

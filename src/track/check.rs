@@ -36,9 +36,7 @@ pub fn rms_checks(irr: &Irregularities, length: f64) -> Vec<RmsCheck> {
             RmsCheck {
                 channel: ch,
                 sample_rms: var.sqrt(),
-                formula_rms: spec
-                    .class
-                    .band_rms(ch, spec.min_wavelength, spec.max_wavelength),
+                formula_rms: spec.band_rms(ch),
             }
         })
         .collect()
@@ -82,7 +80,7 @@ pub fn psd_comparison(irr: &Irregularities, length: f64) -> PsdComparison {
     let formula = Channel::ALL.map(|ch| {
         omega
             .iter()
-            .map(|&w| if w > 0.0 { spec.class.psd(ch, w) } else { 0.0 })
+            .map(|&w| if w > 0.0 { spec.psd(ch, w) } else { 0.0 })
             .collect()
     });
     PsdComparison {

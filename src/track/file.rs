@@ -2,7 +2,7 @@
 //! validated into [`TrackSpec`] with errors that name the file and the field.
 
 use super::alignment::{Section, SectionKind, Turn};
-use super::irregularity::{FraClass, IrregularitySpec};
+use super::irregularity::{FraClass, IrregularitySpec, Spectrum};
 use super::profile::{Grade, VerticalProfile};
 use crate::error::{Error, Result};
 use serde::Deserialize;
@@ -75,6 +75,8 @@ struct GradeFile {
 #[serde(deny_unknown_fields)]
 struct IrregularityFile {
     class: i64,
+    /// `fra` (default), `german_low` or `german_high`.
+    spectrum: Option<String>,
     #[serde(default = "default_min_wavelength")]
     min_wavelength_m: f64,
     #[serde(default = "default_max_wavelength")]
@@ -342,7 +344,20 @@ impl TrackSpec {
                 let hi = irr.gauge_max_mm.map_or(hi, |v| v * 1e-3);
                 check_range(path, "irregularity.gauge_min_mm", lo * 1e3, -50.0, -1.0)?;
                 check_range(path, "irregularity.gauge_max_mm", hi * 1e3, 1.0, 50.0)?;
+                let spectrum = match irr.spectrum.as_deref() {
+                    None => Spectrum::Fra,
+                    Some(name) => Spectrum::parse(name).ok_or_else(|| {
+                        err(
+                            "irregularity.spectrum".into(),
+                            format!(
+                                "unknown spectrum \"{name}\": use {}",
+                                Spectrum::NAMES.join(", ")
+                            ),
+                        )
+                    })?,
+                };
                 Some(IrregularitySpec {
+                    spectrum,
                     gauge_limits: (lo, hi),
                     smooth_start: irr.smooth_start_m,
                     class,

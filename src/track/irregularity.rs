@@ -1,4 +1,5 @@
-//! Track irregularities from the US FRA track-class PSDs (assets/docs/physics.md §3.2).
+//! Track irregularities from the US FRA track-class PSDs or the German low- and
+//! high-interference spectra (assets/docs/physics.md §3.2).
 //!
 //! One-sided PSDs in cm²/(rad/m), Ω in rad/m, k = 0.25:
 //! vertical profile and alignment `k·A·Ω_c²/(Ω²(Ω² + Ω_c²))`, cross-level and gauge
@@ -88,24 +89,109 @@ impl FraClass {
         cm2 * CM2
     }
 
-    /// RMS (m) that the PSD gives over the wavelength band `[λ_min, λ_max]`:
-    /// `σ² = ∫ S dΩ` from `2π/λ_max` to `2π/λ_min` (Simpson's rule in ln Ω).
+    /// RMS (m) that the PSD gives over the wavelength band `[λ_min, λ_max]` (see
+    /// [`band_rms`]).
     pub fn band_rms(&self, channel: Channel, min_wavelength: f64, max_wavelength: f64) -> f64 {
-        let (lo, hi) = (
-            (2.0 * std::f64::consts::PI / max_wavelength).ln(),
-            (2.0 * std::f64::consts::PI / min_wavelength).ln(),
-        );
-        let n = 4000; // even
-        let h = (hi - lo) / n as f64;
-        let f = |u: f64| {
-            let w = u.exp();
-            self.psd(channel, w) * w // dΩ = Ω du
-        };
-        let mut sum = f(lo) + f(hi);
-        for i in 1..n {
-            sum += f(lo + i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        band_rms(|w| self.psd(channel, w), min_wavelength, max_wavelength)
+    }
+}
+
+/// RMS that a one-sided PSD `psd(Ω)` (m²/(rad/m)) gives over the wavelength band
+/// `[λ_min, λ_max]`: `σ² = ∫ S dΩ` from `2π/λ_max` to `2π/λ_min` (Simpson's rule in ln Ω).
+pub fn band_rms(psd: impl Fn(f64) -> f64, min_wavelength: f64, max_wavelength: f64) -> f64 {
+    let (lo, hi) = (
+        (2.0 * std::f64::consts::PI / max_wavelength).ln(),
+        (2.0 * std::f64::consts::PI / min_wavelength).ln(),
+    );
+    let n = 4000; // even
+    let h = (hi - lo) / n as f64;
+    let f = |u: f64| {
+        let w = u.exp();
+        psd(w) * w // dΩ = Ω du
+    };
+    let mut sum = f(lo) + f(hi);
+    for i in 1..n {
+        sum += f(lo + i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+    }
+    (sum * h / 3.0).sqrt()
+}
+
+/// The German track spectra for low and high interference (DB; as published in the
+/// vehicle–track literature, e.g. Zhai, *Vehicle–Track Coupled Dynamics*, 2020, §2), one-sided
+/// in m²/(rad/m), Ω in rad/m, `b` = 0.75 m (half the rail spacing):
+/// vertical and alignment `A·Ω_c²/((Ω² + Ω_r²)(Ω² + Ω_c²))`; cross level as an angle
+/// `(A_v/b²)·Ω_c²·Ω²/((Ω² + Ω_r²)(Ω² + Ω_c²)(Ω² + Ω_s²))` (rad²/(rad/m); times `(2b)²` as a
+/// height difference); gauge `A_g·Ω_c²·Ω²/((Ω² + Ω_r²)(Ω² + Ω_c²)(Ω² + Ω_s²))`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GermanSpectrum {
+    /// `true`: the high-interference spectrum (conventional lines); `false`: low (high-speed).
+    pub high: bool,
+}
+
+/// Ω_c, Ω_r, Ω_s of the German spectra, rad/m.
+const GERMAN_OMEGA: (f64, f64, f64) = (0.8246, 0.0206, 0.4380);
+/// Half the rail spacing the cross-level form is written for, m.
+const GERMAN_B: f64 = 0.75;
+
+impl GermanSpectrum {
+    /// (A_v, A_a, A_g), m·rad. A_v, A_a as published (low 4.032e-7, 2.119e-7; high 1.080e-6,
+    /// 6.125e-7); A_g (low 5.32e-8, high 1.032e-7) from the same table, checked against one
+    /// source only (an estimate until a second confirms it).
+    fn roughness(&self) -> (f64, f64, f64) {
+        if self.high {
+            (1.080e-6, 6.125e-7, 1.032e-7)
+        } else {
+            (4.032e-7, 2.119e-7, 5.32e-8)
         }
-        (sum * h / 3.0).sqrt()
+    }
+
+    /// One-sided PSD of a channel at Ω (rad/m), m²/(rad/m); cross level as the height
+    /// difference between the rails over the 1.5 m rail spacing.
+    pub fn psd(&self, channel: Channel, omega: f64) -> f64 {
+        let (a_v, a_a, a_g) = self.roughness();
+        let (wc, wr, ws) = GERMAN_OMEGA;
+        let w2 = omega * omega;
+        let base = wc * wc / ((w2 + wr * wr) * (w2 + wc * wc));
+        let twist = base * w2 / (w2 + ws * ws);
+        match channel {
+            Channel::Vertical => a_v * base,
+            Channel::Alignment => a_a * base,
+            Channel::CrossLevel => (a_v / (GERMAN_B * GERMAN_B)) * twist * (2.0 * GERMAN_B).powi(2),
+            Channel::Gauge => a_g * twist,
+        }
+    }
+}
+
+/// The spectrum irregularities are drawn from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Spectrum {
+    /// A US FRA class (the spec's `class`).
+    Fra,
+    /// A German spectrum.
+    German(GermanSpectrum),
+}
+
+impl Spectrum {
+    /// Names as the track file writes them: `fra`, `german_low`, `german_high`.
+    pub const NAMES: [&'static str; 3] = ["fra", "german_low", "german_high"];
+
+    /// The spectrum of a name in [`Spectrum::NAMES`].
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "fra" => Some(Spectrum::Fra),
+            "german_low" => Some(Spectrum::German(GermanSpectrum { high: false })),
+            "german_high" => Some(Spectrum::German(GermanSpectrum { high: true })),
+            _ => None,
+        }
+    }
+
+    /// Its name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Spectrum::Fra => "fra",
+            Spectrum::German(g) if g.high => "german_high",
+            Spectrum::German(_) => "german_low",
+        }
     }
 }
 
@@ -145,8 +231,11 @@ impl Channel {
 /// Irregularity settings of a track file.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IrregularitySpec {
-    /// FRA class.
+    /// FRA class (its PSDs unless `spectrum` is German; always its gauge limits unless the file
+    /// sets them).
     pub class: FraClass,
+    /// The spectrum drawn from.
+    pub spectrum: Spectrum,
     /// Shortest wavelength synthesised, m.
     pub min_wavelength: f64,
     /// Longest wavelength synthesised, m.
@@ -161,6 +250,25 @@ pub struct IrregularitySpec {
     /// Narrowest and widest gauge deviation allowed, m (default: the class's
     /// [`FraClass::gauge_limits`]). The synthesised gauge is held inside by [`soft_limit`].
     pub gauge_limits: (f64, f64),
+}
+
+impl IrregularitySpec {
+    /// One-sided PSD of a channel at Ω (rad/m), m²/(rad/m), of the spectrum drawn from.
+    pub fn psd(&self, channel: Channel, omega: f64) -> f64 {
+        match self.spectrum {
+            Spectrum::Fra => self.class.psd(channel, omega),
+            Spectrum::German(g) => g.psd(channel, omega),
+        }
+    }
+
+    /// RMS (m) of a channel over the spec's wavelength band, from [`IrregularitySpec::psd`].
+    pub fn band_rms(&self, channel: Channel) -> f64 {
+        band_rms(
+            |w| self.psd(channel, w),
+            self.min_wavelength,
+            self.max_wavelength,
+        )
+    }
 }
 
 /// Holds `x` inside `(lo, hi)` (lo < 0 < hi) with a smooth knee: unchanged within 75 % of each
@@ -236,7 +344,7 @@ impl Irregularities {
         let samples = Channel::ALL.map(|ch| {
             let mut buf = vec![Complex64::new(0.0, 0.0); n_fft];
             for (k, b) in buf.iter_mut().enumerate().take(k_hi + 1).skip(k_lo) {
-                let amp = (2.0 * spec.class.psd(ch, k as f64 * d_omega) * d_omega).sqrt();
+                let amp = (2.0 * spec.psd(ch, k as f64 * d_omega) * d_omega).sqrt();
                 *b = Complex64::from_polar(amp, phase.sample(&mut rng));
             }
             fft.process(&mut buf);

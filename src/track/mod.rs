@@ -13,7 +13,9 @@ mod support;
 
 pub use alignment::{Alignment, Section, SectionKind, Turn, cant_deficiency_acceleration};
 pub use file::{MAX_CANT_MM, MAX_GRADIENT_PERMILLE, TrackSpec};
-pub use irregularity::{Channel, FraClass, Irregularities, IrregularitySpec, RailIrregularity};
+pub use irregularity::{
+    Channel, FraClass, GermanSpectrum, Irregularities, IrregularitySpec, RailIrregularity, Spectrum,
+};
 pub use profile::{Grade, VerticalProfile};
 pub use support::{RailSupport, Support};
 
