@@ -24,6 +24,7 @@ pub mod report;
 pub mod sensors;
 pub mod sim;
 pub mod track;
+pub mod vary;
 pub mod vehicle;
 pub mod view;
 

@@ -6,6 +6,7 @@
 //! class, start position). Paths are relative to the plan file; assets/docs/file-formats.md lists every key.
 
 use crate::error::{Error, Result};
+use crate::vary::Vary;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -17,6 +18,7 @@ struct PlanFile {
     duration_s: f64,
     seeds: Option<SeedsFile>,
     dataset: Option<DatasetFile>,
+    vary: Option<toml::Table>,
     #[serde(default)]
     condition: Vec<ConditionFile>,
 }
@@ -47,6 +49,7 @@ struct ConditionFile {
     seeds: Option<SeedsFile>,
     class: Option<i64>,
     start_m: Option<f64>,
+    vary: Option<toml::Table>,
 }
 
 /// Largest number of seeds one list or range may give (a typo such as `"1-100000000"` should
@@ -132,6 +135,8 @@ pub struct Condition {
     /// Distance along the track of the vehicle centre at the start, m (default: just far
     /// enough for the rear wheelset to be on the track).
     pub start_m: Option<f64>,
+    /// What varies from run to run: the plan's `[vary]` with the condition's own over it.
+    pub vary: Vary,
 }
 
 impl Condition {
@@ -174,6 +179,10 @@ impl Plan {
             }
         };
         positive("duration_s".into(), raw.duration_s)?;
+        let plan_vary = match &raw.vary {
+            Some(t) => Vary::parse(t, path, "vary")?,
+            None => Vary::default(),
+        };
         let plan_seeds = match raw.seeds {
             Some(s) => seeds(path, "seeds", s)?,
             None => vec![1],
@@ -258,7 +267,12 @@ impl Plan {
                     format!("must be a distance ≥ 0 along the track, got {s}"),
                 ));
             }
+            let vary = match &c.vary {
+                Some(t) => plan_vary.merged(&Vary::parse(t, path, &f("vary"))?),
+                None => plan_vary.clone(),
+            };
             conditions.push(Condition {
+                vary,
                 name: c.name,
                 track: dir.join(c.track),
                 speed_kmh: speed,
@@ -304,5 +318,29 @@ impl Plan {
             conditions,
             dataset,
         })
+    }
+}
+
+impl Plan {
+    /// Tries every condition's variations at the ends of their ranges on the condition's own
+    /// files ([`crate::vary::check`]), before any run: an error names the plan key.
+    pub fn check_vary(&self) -> Result<()> {
+        let mut tried = Vec::new();
+        for (index, c) in self.conditions.iter().enumerate() {
+            crate::vary::check(
+                &self.source,
+                crate::vary::Subject {
+                    index,
+                    name: &c.name,
+                    vehicle: &c.vehicle,
+                    track: &c.track,
+                    speed_kmh: c.speed_kmh,
+                    class: c.class,
+                },
+                &c.vary,
+                &mut tried,
+            )?;
+        }
+        Ok(())
     }
 }

@@ -42,5 +42,7 @@ mod sklearn;
 mod stability;
 #[path = "track.rs"]
 mod track;
+#[path = "vary.rs"]
+mod vary;
 #[path = "view.rs"]
 mod view;

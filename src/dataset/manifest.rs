@@ -121,6 +121,10 @@ pub struct RunEntry {
     pub wall_time_s: f64,
     /// Largest |Y/Q| of each wheel, 1L … 4R.
     pub peak_y_over_q: Vec<f64>,
+    /// What the plan's `[vary]` drew for this run, by key: a value, or `{"scale": factor}`
+    /// (absent when nothing varies).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub draws: std::collections::BTreeMap<String, serde_json::Value>,
 }
 
 /// The manifest of a data set.
@@ -287,9 +291,16 @@ pub(super) fn run_key(
     track_hash: &str,
     vehicle_hash: &str,
     dataset: &DatasetOptions,
+    draws: &crate::vary::Draws,
 ) -> String {
     // Options added later enter the key only when set, so existing data sets keep their keys.
     let mut extra = String::new();
+    if !draws.is_empty() {
+        extra += &format!(
+            "|vary={}",
+            serde_json::to_string(&crate::vary::to_json(draws)).unwrap_or_default()
+        );
+    }
     if let Some(c) = run.condition.class {
         extra += &format!("|class={c}");
     }

@@ -97,6 +97,15 @@ impl RunSpec {
     }
 }
 
+/// A run made ready before any runs: its track (drawn), the track file's hash, its draws and
+/// its speed.
+struct Prepared {
+    spec: TrackSpec,
+    track_hash: String,
+    draws: crate::vary::Draws,
+    speed_kmh: f64,
+}
+
 /// Every (condition, seed) pair of a plan, in plan order.
 pub fn runs(plan: &Plan) -> Vec<RunSpec> {
     let mut out = Vec::new();
@@ -221,9 +230,19 @@ pub fn generate(
         .into_iter()
         .filter(|r| opts.shard.is_none_or(|(i, n)| r.index % n == i - 1))
         .collect();
+    // Every variation tried at the ends of its range, naming the plan key, before any run.
+    plan.check_vary()?;
     let mut tracks = Vec::new();
     for r in &mine {
-        let mut spec = TrackSpec::load(&r.condition.track)?;
+        let draws = r.condition.vary.draw(&r.condition.name, r.seed);
+        let speed_kmh = crate::vary::speed_kmh(r.condition.speed_kmh, &draws).map_err(|e| {
+            Error::config(
+                &plan.source,
+                format!("condition {} (seed {})", r.condition.name, r.seed),
+                e.to_string(),
+            )
+        })?;
+        let mut spec = crate::vary::track_for(&r.condition.track, &draws)?;
         if let Some(class) = r.condition.class {
             set_class(&mut spec, class).map_err(|m| {
                 Error::config(
@@ -246,7 +265,12 @@ pub fn generate(
                 ),
             ));
         }
-        tracks.push((spec, file_hash(&r.condition.track)?));
+        tracks.push(Prepared {
+            spec,
+            track_hash: file_hash(&r.condition.track)?,
+            draws,
+            speed_kmh,
+        });
     }
     let done: &[RunEntry] = previous.as_ref().map_or(&[], |m| &m.runs);
     for (_, v, _) in &vehicles {
@@ -299,12 +323,17 @@ pub fn generate(
     let first_error: Mutex<Option<Error>> = Mutex::new(None);
     let work = |k: usize| -> Result<()> {
         let run = &mine[k];
-        let (spec, track_hash) = &tracks[k];
-        let (_, vehicle, vehicle_hash) = vehicles
+        let Prepared {
+            spec,
+            track_hash,
+            draws,
+            speed_kmh,
+        } = &tracks[k];
+        let (_, shared, vehicle_hash) = vehicles
             .iter()
             .find(|v| v.0 == run.condition.vehicle)
             .expect("every condition's vehicle is loaded");
-        let key = run_key(run, opts, track_hash, vehicle_hash, dataset);
+        let key = run_key(run, opts, track_hash, vehicle_hash, dataset, draws);
         let file = run.file_name(opts.format);
         let path = opts.out.join(&file);
         if let Some(entry) = done.iter().find(|e| e.key == key)
@@ -319,9 +348,20 @@ pub fn generate(
             return Ok(());
         }
         events(Event::Started(file.clone()));
+        // A wagon drawn for this run, or the condition's own.
+        let drawn_vehicle = if draws.keys().any(|k| k.starts_with("vehicle.")) {
+            Some(
+                crate::vary::vehicle_for(&run.condition.vehicle, draws).map_err(|e| {
+                    Error::Domain(format!("{} (seed {}): {e}", run.condition.name, run.seed))
+                })?,
+            )
+        } else {
+            None
+        };
+        let vehicle = drawn_vehicle.as_ref().unwrap_or(shared);
         let track = Track::new(spec.clone(), Some(run.seed));
         let cfg = SimConfig {
-            speed: run.condition.speed(),
+            speed: speed_kmh / 3.6,
             duration: run.condition.duration,
             settle: opts.settle,
             start: run.condition.start_m,
@@ -350,7 +390,7 @@ pub fn generate(
                 hash_fnv1a: track_hash.clone(),
                 name: spec.name.clone(),
             },
-            speed_kmh: run.condition.speed_kmh,
+            speed_kmh: *speed_kmh,
             duration_s: run.condition.duration,
             vehicle: Some(vehicle.name.clone()),
             class: run.condition.class,
@@ -358,6 +398,7 @@ pub fn generate(
             rows: rec.rows.len(),
             wall_time_s: rec.summary.wall,
             peak_y_over_q: rec.summary.peak_y_over_q,
+            draws: crate::vary::to_json(draws),
         };
         let mut m = manifest.lock().expect("manifest lock");
         if let Some(channels) = &m.channels {

@@ -116,10 +116,25 @@ struct SensorsFile {
 /// Reads a vehicle TOML file and the URDF it names, validates everything and computes the
 /// static preloads of the supporting elements from the load path.
 pub(super) fn load(path: &Path) -> Result<Vehicle> {
-    let raw: VehicleFile = crate::io::read_toml(path)?;
+    load_edited(path, None, &mut |_| Ok(()))
+}
+
+/// [`load`] with the file's text given (`text`, the path still resolving the URDF and the
+/// profiles) and the URDF's bodies changed by `bodies` before anything binds to them.
+pub(super) fn load_edited(
+    path: &Path,
+    text: Option<&str>,
+    bodies: &mut dyn FnMut(&mut [super::Body]) -> Result<()>,
+) -> Result<Vehicle> {
+    let raw: VehicleFile = match text {
+        Some(t) => crate::io::parse_toml(t, path)?,
+        None => crate::io::read_toml(path)?,
+    };
     let dir = path.parent().unwrap_or(Path::new("."));
     let urdf_path = dir.join(&raw.urdf);
-    let bodies = super::urdf::read_urdf(&urdf_path)?;
+    let mut bodies_read = super::urdf::read_urdf(&urdf_path)?;
+    bodies(&mut bodies_read)?;
+    let bodies = bodies_read;
     let cfg = |field: String, msg: String| Error::config(path, field, msg);
     // One binder for the whole file: the elements bind through it, and so does the rest.
     let b = Binder {

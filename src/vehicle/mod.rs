@@ -242,6 +242,18 @@ impl Vehicle {
         file::load(path)
     }
 
+    /// [`Vehicle::load`] of an edited vehicle: the file's TOML as `text` (the path still
+    /// resolves its URDF and profiles; `None` reads the file) and its URDF bodies changed by
+    /// `bodies` before the elements bind to them and the static loads are shared out. What a
+    /// plan's `[vary]` draws reaches the wagon this way, validated as the file would be.
+    pub fn load_edited(
+        path: &Path,
+        text: Option<&str>,
+        bodies: &mut dyn FnMut(&mut [Body]) -> Result<()>,
+    ) -> Result<Self> {
+        file::load_edited(path, text, bodies)
+    }
+
     /// Preloads of the vertical supports from the load path, top down: each body's weight plus
     /// what it carries is shared equally by its supports without a given preload (side bearers
     /// keep theirs). Checks that the shares balance the body's moments.

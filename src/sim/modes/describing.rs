@@ -120,14 +120,9 @@ fn factor(g: &DVector<Complex<f64>>, g_stuck: &DVector<Complex<f64>>) -> Option<
     (norm > 0.0).then(|| g_stuck.dotc(g) / norm)
 }
 
-/// The weight of sample `k` of `steps` per cycle in the first harmonic `(1/π)∫F·e^{−iθ}dθ`.
-pub(super) fn harmonic_weight(k: usize, steps: usize) -> Complex<f64> {
-    let theta = 2.0 * std::f64::consts::PI * k as f64 / steps as f64;
-    Complex::from_polar(2.0 / steps as f64, -theta)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::linear::harmonic_weight;
     use super::*;
 
     /// An elasto-plastic slider (stick stiffness `k`, slip force `f`) driven through

@@ -312,7 +312,7 @@ impl<'a> Linear<'a> {
             let mut wrenches = vec![crate::vehicle::Wrench::default(); nb];
             element.apply(&self.sim.states, &mut memory, &mut wrenches);
             if k >= STEPS {
-                let e = super::describing::harmonic_weight(k, STEPS);
+                let e = harmonic_weight(k, STEPS);
                 for (i, w) in wrenches.iter().enumerate() {
                     for j in 0..3 {
                         h[6 * i + j] += e * w.force[j];
@@ -442,4 +442,10 @@ impl<'a> Linear<'a> {
             shape,
         }
     }
+}
+
+/// The weight of sample `k` of `steps` per cycle in the first harmonic `(1/π)∫F·e^{−iθ}dθ`.
+pub(super) fn harmonic_weight(k: usize, steps: usize) -> Complex<f64> {
+    let theta = 2.0 * std::f64::consts::PI * k as f64 / steps as f64;
+    Complex::from_polar(2.0 / steps as f64, -theta)
 }

@@ -1,0 +1,202 @@
+//! Wagons and tracks that vary (`[vary]` in plan files, issue 36): a drawn value reaches the
+//! simulation, the same seed draws the same wagon, no two runs share a draw, bad keys and
+//! ranges are refused naming the plan key, and a varied data set is the same bytes twice.
+
+use railforce::plan::Plan;
+use railforce::vary::{Drawn, Draws, vehicle_for};
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn plan() -> Plan {
+    Plan::load(&root().join("tests/fixtures/plans/varied.plan.toml")).unwrap()
+}
+
+/// A plan with `vary` as its `[vary]` table, written next to the fixtures.
+fn plan_with(vary: &str, name: &str) -> railforce::error::Result<Plan> {
+    let dir = std::env::temp_dir().join(format!("railforce-vary-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let r = root();
+    let text = format!(
+        "vehicle = \"{}\"\nduration_s = 1.0\n[vary]\n{vary}\n[[condition]]\nname = \"t\"\ntrack = \"{}\"\nspeed_kmh = 60.0\n",
+        r.join("vehicles/c80.toml").display(),
+        r.join("tracks/tangent.toml").display()
+    );
+    let path = dir.join("p.plan.toml");
+    std::fs::write(&path, text).unwrap();
+    Plan::load(&path).and_then(|p| p.check_vary().map(|_| p))
+}
+
+/// A heavier carbody raises every wheel's static load by its share: +10 t over 8 wheels is
+/// +12.26 kN per wheel, within 0.5 %.
+#[test]
+fn a_heavier_draw_raises_the_static_wheel_load_by_its_share() {
+    let file = root().join("vehicles/c80.toml");
+    let base = railforce::vehicle::Vehicle::load(&file).unwrap();
+    let carbody = base
+        .bodies
+        .iter()
+        .find(|b| b.name == "carbody")
+        .unwrap()
+        .mass;
+    let mut draws = Draws::new();
+    draws.insert(
+        "vehicle.body.carbody.mass".into(),
+        Drawn {
+            value: toml::Value::Float(carbody + 10_000.0),
+            scale: false,
+        },
+    );
+    let heavy = vehicle_for(&file, &draws).unwrap();
+    let q = |v: &railforce::vehicle::Vehicle| {
+        let s = railforce::sim::checks::static_loads(v, 1.0).unwrap();
+        s.loads.iter().sum::<f64>() / s.loads.len() as f64
+    };
+    let rise = q(&heavy) - q(&base);
+    let want = 10_000.0 * railforce::GRAVITY / 8.0;
+    assert!((rise / want - 1.0).abs() < 0.005, "{rise} N vs {want} N");
+}
+
+/// The same condition and seed draw the same values; another seed or condition draws others;
+/// the condition's own `[condition.vary]` adds its keys; scaled keys say so.
+#[test]
+fn the_same_seed_draws_the_same_wagon_and_no_two_runs_share_one() {
+    let p = plan();
+    let (t, c) = (&p.conditions[0], &p.conditions[1]);
+    assert_eq!(t.vary.draw("tangent", 1), t.vary.draw("tangent", 1));
+    let all: Vec<Draws> = [(t, 1), (t, 2), (c, 1), (c, 2)]
+        .iter()
+        .map(|(cond, seed)| cond.vary.draw(&cond.name, *seed))
+        .collect();
+    for i in 0..all.len() {
+        for j in 0..i {
+            assert_ne!(
+                all[i]["vehicle.contact.friction"], all[j]["vehicle.contact.friction"],
+                "runs {i} and {j} share a draw"
+            );
+        }
+    }
+    let d = &all[0];
+    assert!(d["vehicle.body.carbody.mass"].scale);
+    assert_eq!(
+        d["vehicle.body.carbody.mass"], d["vehicle.body.carbody.inertia"],
+        "with takes the same value"
+    );
+    assert!(!d.contains_key("track.irregularity.spectrum"));
+    assert!(all[2].contains_key("track.irregularity.spectrum"));
+    for d in &all {
+        let f = d["vehicle.contact.friction"].value.as_float().unwrap();
+        assert!((0.15..=0.5).contains(&f));
+        let v = d["speed_kmh"].value.as_float().unwrap();
+        assert!((55.0..=85.0).contains(&v), "normal truncated at ±3σ: {v}");
+    }
+    p.check_vary().unwrap();
+}
+
+/// A key that names nothing, a value the file's loader refuses at an end of the range, a body
+/// that is not in the URDF and a list set without scale are refused before any run, naming the
+/// plan key.
+#[test]
+fn bad_vary_keys_and_ranges_are_refused_naming_the_key() {
+    for (vary, key, says) in [
+        (
+            "\"vehicle.contactt.friction\" = { uniform = [0.2, 0.4] }",
+            "vehicle.contactt.friction",
+            "no \"contactt\"",
+        ),
+        (
+            "\"vehicle.contact.frictio\" = { uniform = [0.2, 0.4] }",
+            "vehicle.contact.frictio",
+            "frictio",
+        ),
+        (
+            "\"vehicle.contact.friction\" = { uniform = [-0.1, 0.4] }",
+            "vehicle.contact.friction",
+            "must be positive",
+        ),
+        (
+            "\"vehicle.body.payload.mass\" = { uniform = [1.0, 2.0] }",
+            "vehicle.body.payload.mass",
+            "no body \"payload\"",
+        ),
+        (
+            "\"vehicle.shear_pad.stiffness\" = { uniform = [1e6, 2e6] }",
+            "vehicle.shear_pad.stiffness",
+            "scale it",
+        ),
+        (
+            "\"track.irregularity.class\" = { one_of = [5, 9] }",
+            "track.irregularity.class",
+            "unknown FRA class 9",
+        ),
+        (
+            "\"speed_kmh\" = { uniform = [150.0, 250.0] }",
+            "speed_kmh",
+            "outside (0, 200]",
+        ),
+        (
+            "\"wagon.mass\" = { uniform = [1.0, 2.0] }",
+            "wagon.mass",
+            "a key starts with",
+        ),
+        (
+            "\"vehicle.contact.friction\" = { uniform = [0.4, 0.2] }",
+            "vehicle.contact.friction",
+            "runs downwards",
+        ),
+    ] {
+        let e = plan_with(vary, &key.replace('.', "_"))
+            .err()
+            .unwrap_or_else(|| panic!("{vary} was accepted"))
+            .to_string();
+        assert!(
+            e.contains(&format!("vary.\"{key}\"")) && e.contains(says),
+            "{vary}: {e}"
+        );
+    }
+}
+
+/// A varied data set: every run's draws in the manifest, the drawn speed as its speed, and the
+/// same bytes when generated again.
+#[test]
+fn a_varied_data_set_records_its_draws_and_repeats_byte_for_byte() {
+    let out =
+        |k: u32| std::env::temp_dir().join(format!("railforce-varied-{}-{k}", std::process::id()));
+    for k in [1, 2] {
+        let o = out(k);
+        let _ = std::fs::remove_dir_all(&o);
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .args(["generate", "--plan"])
+            .arg(root().join("tests/fixtures/plans/varied.plan.toml"))
+            .args(["--format", "csv", "--out"])
+            .arg(&o)
+            .output()
+            .unwrap();
+        assert!(
+            status.status.success(),
+            "{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+    }
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out(1).join("manifest.json")).unwrap())
+            .unwrap();
+    let runs = m["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 4);
+    for r in runs {
+        let d = &r["draws"];
+        assert!(d["vehicle.contact.friction"].is_number(), "{r}");
+        assert!(d["vehicle.body.carbody.mass"]["scale"].is_number(), "{r}");
+        assert_eq!(r["speed_kmh"], d["speed_kmh"]);
+        let file = r["file"].as_str().unwrap();
+        let a = std::fs::read(out(1).join(file)).unwrap();
+        let b = std::fs::read(out(2).join(file)).unwrap();
+        assert!(a == b, "{file} differs between two generations");
+    }
+    for k in [1, 2] {
+        let _ = std::fs::remove_dir_all(out(k));
+    }
+    let _ = Path::new("");
+}
