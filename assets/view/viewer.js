@@ -11,7 +11,7 @@
   const $ = (id) => document.getElementById(id);
   const slider = $("slider"), play = $("play"), speedSel = $("speed"), clock = $("clock");
   const COL = { ink: "#222", grid: "#ddd", rail: "#8a8f98", wheel: "#c9b27c", truth: "#1f5fbf",
-    ident: "#e07b00", limit: "#c62828", contact: "#d81b60", soft: "#666" };
+    ident: "#e07b00", band: "rgba(224, 123, 0, 0.18)", limit: "#c62828", contact: "#d81b60", soft: "#666" };
   slider.max = String(N - 1);
   let frame = 0, playing = false, last = null, simTime = S.time[0];
 
@@ -213,8 +213,8 @@
   function tracePlots() {
     const T = S.traces, I = S.identified, Lm = S.limits;
     return [
-      { name: "Y (kN)", t: T.y, i: I && I.y, lim: [] },
-      { name: "Q (kN)", t: T.q, i: I && I.q, lim: [[Lm.q_min, "Q min (unloading " + Lm.q_min.toFixed(0) + " kN)"], [Lm.q_static, "static Q̄"]] },
+      { name: "Y (kN)", t: T.y, i: I && I.y, b: I && I.band && I.band.y, lim: [] },
+      { name: "Q (kN)", t: T.q, i: I && I.q, b: I && I.band && I.band.q, lim: [[Lm.q_min, "Q min (unloading " + Lm.q_min.toFixed(0) + " kN)"], [Lm.q_static, "static Q̄"]] },
       { name: "|Y|/Q", t: T.y_over_q, i: I && I.y_over_q, lim: [[Lm.y_over_q, "limit " + Lm.y_over_q]] },
     ];
   }
@@ -226,7 +226,7 @@
     const { left, right, ph, t0, t1, X } = traceLayout(c);
     tracePlots().forEach((p, k) => {
       const top = 10 + k * ph, bot = top + ph - 22;
-      const vals = p.t.concat(p.i || [], p.lim.map((l) => l[0])).filter((v) => v !== null && isFinite(v));
+      const vals = p.t.concat(p.i || [], p.b ? p.b[0].concat(p.b[1]) : [], p.lim.map((l) => l[0])).filter((v) => v !== null && isFinite(v));
       let lo = Math.min(...vals), hi = Math.max(...vals);
       if (!(hi > lo)) { lo -= 1; hi += 1; }
       const pad = 0.08 * (hi - lo); lo -= pad; hi += pad;
@@ -243,6 +243,19 @@
         arr.forEach((v, j) => { if (v === null || !isFinite(v)) { pen = false; return; } const x = X(S.time[j]), y = Y(v); pen ? g.lineTo(x, y) : g.moveTo(x, y); pen = true; });
         g.stroke(); g.setLineDash([]);
       };
+      if (p.b) {
+        // The identified force's interval (identify --coverage): a shaded band, drawn first.
+        g.fillStyle = COL.band; g.beginPath(); let open = false;
+        const close = (j0, j1) => { for (let j = j1; j >= j0; j--) g.lineTo(X(S.time[j]), Y(p.b[0][j])); g.closePath(); g.fill(); g.beginPath(); };
+        let start = 0;
+        p.b[1].forEach((v, j) => {
+          const ok = v !== null && isFinite(v) && p.b[0][j] !== null && isFinite(p.b[0][j]);
+          if (ok && !open) { g.moveTo(X(S.time[j]), Y(v)); open = true; start = j; }
+          else if (ok) g.lineTo(X(S.time[j]), Y(v));
+          else if (open) { close(start, j - 1); open = false; }
+        });
+        if (open) close(start, p.b[1].length - 1);
+      }
       line(p.t, COL.truth, []);
       if (p.i) line(p.i, COL.ident, [5, 3]);
     });
@@ -263,7 +276,7 @@
     });
     const x = X(S.time[frame]);
     g.strokeStyle = COL.ink; g.lineWidth = 2; g.beginPath(); g.moveTo(x, 6); g.lineTo(x, c.height - 28); g.stroke();
-    $("trace-title").textContent = "Forces of the label wheel " + S.label + (I ? ": true (blue) and identified (orange, dashed)" : ": true");
+    $("trace-title").textContent = "Forces of the label wheel " + S.label + (I ? ": true (blue) and identified (orange, dashed" + (I.band ? ", its interval shaded" : "") + ")" : ": true");
     $("trace-note").textContent = "Limits: " + Lm.source + "." + (S.identified_source ? " Identified: " + S.identified_source + "." : "");
   }
 

@@ -4,7 +4,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use railforce::identify::safety::{IndexReport, Limits, Monitor};
-use railforce::identify::{SensorRows, SensorTable, Streamer, check, identify};
+use railforce::identify::{SensorRows, SensorTable, Streamer, check, identify_with_bands};
 use railforce::learn::model::Model;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -85,6 +85,12 @@ pub struct IdentifyArgs {
     /// Interpolate the input linearly onto 200 Hz instead of refusing another rate.
     #[arg(long)]
     resample: bool,
+    /// Coverage of the interval written around every identified force (`<target>_lo_N`,
+    /// `<target>_hi_N`): split conformal on the model's validation runs, widened where an
+    /// ensemble's members disagree (`train --ensemble N`). Not for streamed input (`-`) or a
+    /// model trained before calibration existed.
+    #[arg(long, default_value_t = 0.9)]
+    coverage: f64,
     #[command(flatten)]
     limits: LimitArgs,
 }
@@ -103,18 +109,41 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
             anyhow::anyhow!("{e}; --resample interpolates a record onto the model's rate")
         }
     })?;
+    if !(args.coverage > 0.0 && args.coverage < 1.0) {
+        bail!(
+            "--coverage {}: give a fraction between 0 and 1, e.g. 0.9",
+            args.coverage
+        );
+    }
     let t0 = std::time::Instant::now();
-    let id = identify(&mut model, &input);
+    let (id, bands) = identify_with_bands(&mut model, &input, Some(args.coverage));
     let secs = t0.elapsed().as_secs_f64();
+    if bands.is_none() {
+        eprintln!(
+            "note: {} has no calibration (trained before 2026-12-02): no intervals; retrain to get them",
+            args.model.display()
+        );
+    }
     let position = input
         .position
         .as_ref()
         .map(|p| railforce::identify::at_labels(&model, p));
     let mut monitor = Monitor::new(&id.targets, &limits, false);
-    let mut s = header(&id.targets, position.is_some(), &monitor.columns());
+    let mut s = header(
+        &id.targets,
+        position.is_some(),
+        bands.is_some(),
+        &monitor.columns(),
+    );
     for (i, t) in id.time.iter().enumerate() {
         let idx = monitor.push(*t, &id.values[i]);
-        s += &row(*t, position.as_ref().map(|p| p[i]), &id.values[i], &idx);
+        s += &row(
+            *t,
+            position.as_ref().map(|p| p[i]),
+            &id.values[i],
+            bands.as_ref().map(|b| b.bounds[i].as_slice()),
+            &idx,
+        );
     }
     let reports = monitor.finish();
     if args.out.as_os_str() == "-" {
@@ -156,14 +185,17 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
 }
 
 /// Header of identify's output: time, the track position when the input has it, each target's
-/// force in N, then each safety index (ASCII names).
-fn header(targets: &[String], position: bool, indices: &[&str]) -> String {
+/// force in N (with its interval's bounds when `bands`), then each safety index (ASCII names).
+fn header(targets: &[String], position: bool, bands: bool, indices: &[&str]) -> String {
     let mut s = String::from("time_s");
     if position {
         s.push_str(",s_m");
     }
     for t in targets {
         let _ = write!(s, ",{t}_N");
+        if bands {
+            let _ = write!(s, ",{t}_lo_N,{t}_hi_N");
+        }
     }
     for c in indices {
         let _ = write!(s, ",{c}");
@@ -173,13 +205,22 @@ fn header(targets: &[String], position: bool, indices: &[&str]) -> String {
 }
 
 /// One output row: the same text whether identified in one go or streamed.
-fn row(t: f64, position: Option<f64>, forces: &[f64], indices: &[f64]) -> String {
+fn row(
+    t: f64,
+    position: Option<f64>,
+    forces: &[f64],
+    bounds: Option<&[(f64, f64)]>,
+    indices: &[f64],
+) -> String {
     let mut s = format!("{:.3}", railforce::identify::safety::on_grid(t));
     if let Some(p) = position {
         let _ = write!(s, ",{p:.3}");
     }
-    for v in forces {
+    for (k, v) in forces.iter().enumerate() {
         let _ = write!(s, ",{v:.1}");
+        if let Some(b) = bounds {
+            let _ = write!(s, ",{:.1},{:.1}", b[k].0, b[k].1);
+        }
     }
     for v in indices {
         let _ = write!(s, ",{v:.4}");
@@ -250,7 +291,7 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits) -> Result<()> {
         ))
     };
     let mut monitor = Monitor::new(&spec.targets, limits, false);
-    w.write_all(header(&spec.targets, has_position, &monitor.columns()).as_bytes())?;
+    w.write_all(header(&spec.targets, has_position, false, &monitor.columns()).as_bytes())?;
     let off = railforce::learn::windows::label_offset(spec.window, spec.label_at);
     let mut positions = std::collections::VecDeque::with_capacity(spec.window);
     let mut st = Streamer::new(model);
@@ -265,7 +306,7 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits) -> Result<()> {
         if let Some((tl, f)) = st.push(t, &values) {
             let idx = monitor.push(tl, &f);
             let p = has_position.then(|| positions[off]);
-            w.write_all(row(tl, p, &f, &idx).as_bytes())?;
+            w.write_all(row(tl, p, &f, None, &idx).as_bytes())?;
             w.flush()?;
         }
     }

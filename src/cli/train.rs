@@ -8,7 +8,8 @@ use railforce::dataset::DataSet;
 use railforce::features::{LabelAt, NoiseProtocol, Selection, Split, SplitRequest};
 use railforce::learn::evaluate::{EvalPart, evaluate};
 use railforce::learn::model::{Model, ModelKind};
-use railforce::learn::train::{GradientEngine, Progress, TrainOptions, train};
+use railforce::learn::train::{GradientEngine, Progress, TrainOptions};
+use railforce::learn::uncertainty::train_ensemble;
 use railforce::learn::windows::{DataRequest, DataSpec};
 use railforce::sensors::PAPER_CHANNELS;
 use std::path::{Path, PathBuf};
@@ -99,9 +100,19 @@ pub struct TrainArgs {
     /// Training windows a classical model is fitted on at most (evenly strided).
     #[arg(long, default_value_t = 40_000)]
     classical_rows: usize,
+    /// Validation windows scored each epoch at most (evenly strided; default: all). The
+    /// experiments use 40 000.
+    #[arg(long)]
+    val_windows: Option<usize>,
     /// Continue from the checkpoint in --out (same data and settings).
     #[arg(long)]
     resume: bool,
+    /// Members of a deep ensemble: N networks (or regressors) from seeds --seed, --seed+1, …;
+    /// the model predicts their mean, and `identify` widens its bands where they disagree.
+    /// Every model is calibrated by split conformal prediction on the validation runs, so
+    /// `identify` writes intervals at --coverage with one member too.
+    #[arg(long, default_value_t = 1)]
+    ensemble: usize,
     /// Train anew into an --out that already holds a model or a checkpoint (without it, and
     /// without --resume, such a folder is refused so that no finished training is lost).
     #[arg(long, conflicts_with = "resume")]
@@ -223,6 +234,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         seed: args.seed,
         windows_per_epoch: args.windows_per_epoch,
         classical_rows: args.classical_rows,
+        val_windows: args.val_windows,
         resume: args.resume,
         // Fresh noise applies to networks under the matched protocol when the data set
         // records its noise; otherwise the one realisation on disk is all there is.
@@ -304,7 +316,24 @@ pub fn run(args: TrainArgs) -> Result<()> {
             }
         }
     }
-    let model = train_with_bar(&ds, &spec, kind, &opts, &args.out)?;
+    let model = train_with_bar(&ds, &spec, kind, &opts, args.ensemble, &args.out)?;
+    if let Some(c) = &model.meta.calibration {
+        println!(
+            "calibrated ({} score) on the {}; the 90 % half-width where the members agree as usual: {}",
+            c.score,
+            c.part,
+            spec.targets
+                .iter()
+                .enumerate()
+                .map(|(k, n)| format!(
+                    "{} {:.2} kN",
+                    short(n),
+                    c.half_width(k, 0.9, c.beta[k]) * model.meta.target_stats.std[k] * 1e-3
+                ))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     let t = &model.meta.training;
     let r2 = t["best_val_r2"]
         .as_array()
@@ -354,12 +383,14 @@ fn target_name(t: &str, labels: &[String]) -> String {
     }
 }
 
-/// Trains with a progress bar on standard error and one line per epoch.
+/// Trains (`members` of an ensemble, one after the other) with a progress bar on standard
+/// error and one line per epoch, then calibrates.
 pub fn train_with_bar(
     ds: &DataSet,
     spec: &DataSpec,
     kind: ModelKind,
     opts: &TrainOptions,
+    members: usize,
     out: &Path,
 ) -> Result<Model> {
     let bar = ProgressBar::new(1);
@@ -367,20 +398,30 @@ pub fn train_with_bar(
         ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg}").expect("template"),
     );
     bar.set_prefix(kind.name());
-    let model = train(ds, spec, kind, opts, out, &mut |p| match p {
-        Progress::Batch { epoch, done, total } => {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-            bar.set_message(format!("epoch {epoch} batches"));
-        }
-        Progress::Epoch(e) => {
-            let r2: Vec<String> = e
-                .val_r2
-                .iter()
-                .zip(&spec.targets)
-                .map(|(r, t)| format!("{} {r:.3}", target_name(t, &ds.labels)))
-                .collect();
-            bar.suspend(|| {
+    let model = train_ensemble(
+        ds,
+        spec,
+        kind,
+        opts,
+        members,
+        out,
+        &mut |member, p| match p {
+            Progress::Batch { epoch, done, total } => {
+                if members > 1 {
+                    bar.set_prefix(format!("{} member {}/{members}", kind.name(), member + 1));
+                }
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+                bar.set_message(format!("epoch {epoch} batches"));
+            }
+            Progress::Epoch(e) => {
+                let r2: Vec<String> = e
+                    .val_r2
+                    .iter()
+                    .zip(&spec.targets)
+                    .map(|(r, t)| format!("{} {r:.3}", target_name(t, &ds.labels)))
+                    .collect();
+                bar.suspend(|| {
                 eprintln!(
                     "epoch {:>3}: loss train {:.4}, val {:.4}; val R² {}; {:.0} windows/s; best epoch {}",
                     e.epoch,
@@ -391,13 +432,14 @@ pub fn train_with_bar(
                     e.best_epoch
                 )
             });
-        }
-        Progress::Fit { done, total } => {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-            bar.set_message("fitting");
-        }
-    })?;
+            }
+            Progress::Fit { done, total } => {
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+                bar.set_message("fitting");
+            }
+        },
+    )?;
     bar.finish_and_clear();
     Ok(model)
 }
@@ -490,5 +532,49 @@ pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
         .unwrap_or_else(|| args.model.join("predictions.csv"));
     ev.write_csv(&out, &model.meta.data.targets)?;
     println!("predictions: {}", out.display());
+    match ev.coverage() {
+        None => println!("no intervals: the model has no calibration (trained before 2026-12-02)"),
+        Some(rows) => {
+            let names: Vec<String> = model
+                .meta
+                .data
+                .targets
+                .iter()
+                .map(|t| target_name(t, &ds.labels))
+                .collect();
+            let mut csv = String::from("condition,target,coverage,mean_width_kn\n");
+            for r in &rows {
+                for (n, (c, w)) in names.iter().zip(&r.targets) {
+                    csv += &format!("{},{n},{c:.4},{w:.3}\n", r.condition);
+                }
+            }
+            let pooled = rows.last().expect("pooled row");
+            let worst: Vec<String> = (0..names.len())
+                .map(|k| {
+                    let (lo, hi) = rows[..rows.len() - 1]
+                        .iter()
+                        .fold((1.0f64, 0.0f64), |a, r| {
+                            (a.0.min(r.targets[k].0), a.1.max(r.targets[k].0))
+                        });
+                    format!(
+                        "{} {:.1} % pooled (conditions {:.1}–{:.1} %), mean width {:.2} kN",
+                        names[k],
+                        pooled.targets[k].0 * 100.0,
+                        lo * 100.0,
+                        hi * 100.0,
+                        pooled.targets[k].1
+                    )
+                })
+                .collect();
+            let path = args.model.join("coverage_per_condition.csv");
+            railforce::io::write_atomic(&path, |w| w.write_all(csv.as_bytes()))?;
+            println!(
+                "intervals at {:.0} % nominal coverage: {}; per condition: {}",
+                railforce::learn::evaluate::EVAL_COVERAGE * 100.0,
+                worst.join("; "),
+                path.display()
+            );
+        }
+    }
     Ok(())
 }

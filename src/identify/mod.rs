@@ -259,6 +259,27 @@ pub type Identified = crate::assess::ForceSeries;
 /// # Ok::<(), railforce::Error>(())
 /// ```
 pub fn identify(model: &mut Model, input: &CheckedInput) -> Identified {
+    identify_with_bands(model, input, None).0
+}
+
+/// Intervals around identified forces: per estimate and target, the lower and upper bound in
+/// N at `coverage` (split conformal on the model's validation runs, widened where an
+/// ensemble's members disagree; `learn::uncertainty`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bands {
+    /// Nominal coverage, 0–1.
+    pub coverage: f64,
+    /// Per estimate, per target: (lower, upper), N.
+    pub bounds: Vec<Vec<(f64, f64)>>,
+}
+
+/// [`identify`], and with `coverage` the interval around every estimate where the model is
+/// calibrated (`None` where it is not: models trained before 2026-12-02).
+pub fn identify_with_bands(
+    model: &mut Model,
+    input: &CheckedInput,
+    coverage: Option<f64>,
+) -> (Identified, Option<Bands>) {
     let spec = model.meta.data.clone();
     let (w, c) = (spec.window, spec.channels.len());
     let n = input.time.len();
@@ -272,15 +293,42 @@ pub fn identify(model: &mut Model, input: &CheckedInput) -> Identified {
     let count = n + 1 - w;
     let mut x = Vec::with_capacity(count.min(4096) * w * c);
     let mut out = Vec::with_capacity(count * spec.targets.len());
+    let mut spread: Vec<f32> = Vec::new();
     for first in (0..count).step_by(4096) {
         let last = (first + 4096).min(count);
         x.clear();
         for s in first..last {
             x.extend_from_slice(&rows[s * c..(s + w) * c]);
         }
-        out.extend(model.predict(&x, last - first));
+        let (m, sp) = model.predict_spread(&x, last - first);
+        out.extend(m);
+        if let Some(sp) = sp {
+            spread.extend(sp);
+        }
     }
-    finish(model, &input.time, out, count)
+    let bands = match (coverage, &model.meta.calibration) {
+        (Some(cov), Some(cal)) => {
+            let o = spec.targets.len();
+            let ts = &model.meta.target_stats;
+            Some(Bands {
+                coverage: cov,
+                bounds: (0..count)
+                    .map(|s| {
+                        (0..o)
+                            .map(|k| {
+                                let sp = spread.get(s * o + k).copied().unwrap_or(0.0) as f64;
+                                let h = cal.half_width(k, cov, sp) * ts.std[k];
+                                let v = out[s * o + k] as f64 * ts.std[k] + ts.mean[k];
+                                (v - h, v + h)
+                            })
+                            .collect()
+                    })
+                    .collect(),
+            })
+        }
+        _ => None,
+    };
+    (finish(model, &input.time, out, count), bands)
 }
 
 fn finish(model: &Model, time: &[f64], out: Vec<f32>, count: usize) -> Identified {

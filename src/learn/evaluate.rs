@@ -33,6 +33,21 @@ pub struct Evaluation {
     pub windows_per_s: f64,
     /// Rows of the prediction table: condition, seed, time, then (true, predicted) in N per target.
     pub rows: Vec<PredictionRow>,
+    /// Per row and target, the half-width (N) of the model's interval at [`EVAL_COVERAGE`]
+    /// (`None`: the model is not calibrated).
+    pub half_widths: Option<Vec<Vec<f64>>>,
+}
+
+/// The coverage at which `evaluate` scores the model's intervals.
+pub const EVAL_COVERAGE: f64 = 0.9;
+
+/// How a model's intervals did on one condition (or pooled), per target.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoverageRow {
+    /// Condition (or `all (pooled)`).
+    pub condition: String,
+    /// Per target: the fraction of true forces inside the interval, and its mean width in kN.
+    pub targets: Vec<(f64, f64)>,
 }
 
 /// Scores `model` on `ds`.
@@ -51,8 +66,21 @@ pub fn evaluate(model: &mut Model, ds: &DataSet, part: EvalPart) -> Result<Evalu
     let prep = prepare(ds, &spec, Some((&stats.0, &stats.1)))?;
     let (x, y) = prep.test.all();
     let t0 = Instant::now();
-    let p = model.predict(&x, prep.test.len());
+    let (p, spread) = model.predict_spread(&x, prep.test.len());
     let windows_per_s = prep.test.len() as f64 / t0.elapsed().as_secs_f64().max(1e-9);
+    let half_widths = model.meta.calibration.as_ref().map(|cal| {
+        let o = prep.test.outputs;
+        (0..prep.test.len())
+            .map(|i| {
+                (0..o)
+                    .map(|k| {
+                        let sp = spread.as_ref().map_or(0.0, |s| s[i * o + k] as f64);
+                        cal.half_width(k, EVAL_COVERAGE, sp) * stats.1.std[k]
+                    })
+                    .collect()
+            })
+            .collect()
+    });
     let m = metrics(&y, &p, &stats.1);
     let time = ds.channel("time_s").ok();
     let o = prep.test.outputs;
@@ -76,10 +104,52 @@ pub fn evaluate(model: &mut Model, ds: &DataSet, part: EvalPart) -> Result<Evalu
         metrics: m,
         windows_per_s,
         rows,
+        half_widths,
     })
 }
 
 impl Evaluation {
+    /// Empirical coverage and mean width of the intervals per condition (in order of first
+    /// appearance), then pooled; `None` for a model without calibration.
+    pub fn coverage(&self) -> Option<Vec<CoverageRow>> {
+        let hw = self.half_widths.as_ref()?;
+        let o = self.rows.first().map_or(0, |r| r.3.len());
+        let mut order: Vec<&str> = Vec::new();
+        for r in &self.rows {
+            if !order.contains(&r.0.as_str()) {
+                order.push(&r.0);
+            }
+        }
+        let score = |pick: &dyn Fn(&str) -> bool, name: String| {
+            let idx: Vec<usize> = (0..self.rows.len())
+                .filter(|&i| pick(&self.rows[i].0))
+                .collect();
+            let n = idx.len().max(1) as f64;
+            CoverageRow {
+                condition: name,
+                targets: (0..o)
+                    .map(|k| {
+                        let inside = idx
+                            .iter()
+                            .filter(|&&i| {
+                                let (y, p) = self.rows[i].3[k];
+                                (y - p).abs() <= hw[i][k]
+                            })
+                            .count() as f64;
+                        let width = idx.iter().map(|&i| 2.0 * hw[i][k]).sum::<f64>() / n;
+                        (inside / n, width * 1e-3)
+                    })
+                    .collect(),
+            }
+        };
+        let mut rows: Vec<CoverageRow> = order
+            .iter()
+            .map(|c| score(&|r: &str| r == *c, c.to_string()))
+            .collect();
+        rows.push(score(&|_| true, "all (pooled)".into()));
+        Some(rows)
+    }
+
     /// Metrics of every condition on its own (conditions in the order they first appear),
     /// from the prediction rows; `stats` are the model's target z-scores. Pooled back
     /// (`Σ n·mse / Σ n`) they give the pooled MSE.

@@ -12,4 +12,5 @@ pub mod metrics;
 pub mod model;
 pub mod neural;
 pub mod train;
+pub mod uncertainty;
 pub mod windows;

@@ -104,6 +104,22 @@ pub struct ModelMeta {
     pub training: serde_json::Value,
     /// railforce version that trained it.
     pub version: String,
+    /// Members of the ensemble (1: a single model); members 2… keep their weights in
+    /// `weights_member<k>.bin` / `model_member<k>.bin`.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub members: usize,
+    /// Conformal calibration on the validation part (`learn::uncertainty`); absent in models
+    /// trained before 2026-12-02.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<super::uncertainty::Calibration>,
+}
+
+fn one() -> usize {
+    1
+}
+
+fn is_one(n: &usize) -> bool {
+    *n == 1
 }
 
 /// The fitted function.
@@ -118,19 +134,44 @@ pub enum Engine {
 pub struct Model {
     /// Metadata.
     pub meta: ModelMeta,
-    /// Weights.
+    /// Weights (of the first member).
     pub engine: Engine,
+    /// The other members of an ensemble (empty for one model).
+    pub members: Vec<Engine>,
 }
 
 const MAGIC: &[u8; 8] = b"RFWEIGHT";
 
 impl Model {
-    /// Standardised predictions `[n, outputs]` for windows `x[n, window, channels]`.
+    /// Standardised predictions `[n, outputs]` for windows `x[n, window, channels]` (an
+    /// ensemble's mean).
     pub fn predict(&mut self, x: &[f32], n: usize) -> Vec<f32> {
-        match &mut self.engine {
+        self.predict_spread(x, n).0
+    }
+
+    /// The prediction and, for an ensemble, its members' spread (population standard
+    /// deviation), both standardised `[n, outputs]`.
+    pub fn predict_spread(&mut self, x: &[f32], n: usize) -> (Vec<f32>, Option<Vec<f32>>) {
+        let run = |e: &mut Engine| match e {
             Engine::Net(net) => net.predict(x, n),
             Engine::Classical(c) => c.predict(x, n),
+        };
+        let first = run(&mut self.engine);
+        if self.members.is_empty() {
+            return (first, None);
         }
+        let mut all = vec![first];
+        for m in &mut self.members {
+            all.push(run(m));
+        }
+        let k = all.len() as f32;
+        let mean: Vec<f32> = (0..all[0].len())
+            .map(|i| all.iter().map(|p| p[i]).sum::<f32>() / k)
+            .collect();
+        let spread = (0..mean.len())
+            .map(|i| (all.iter().map(|p| (p[i] - mean[i]).powi(2)).sum::<f32>() / k).sqrt())
+            .collect();
+        (mean, Some(spread))
     }
 
     /// Writes the model directory (atomically file by file).
@@ -138,13 +179,28 @@ impl Model {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         let json = serde_json::to_string_pretty(&self.meta).expect("model metadata serialises");
         crate::io::write_atomic(&dir.join("model.json"), |w| w.write_all(json.as_bytes()))?;
-        match &self.engine {
-            Engine::Net(net) => write_weights(&dir.join("weights.bin"), &net.params.value),
-            Engine::Classical(c) => {
-                let bytes = c.to_bytes();
-                crate::io::write_atomic(&dir.join("model.bin"), |w| w.write_all(&bytes))
+        for (k, e) in std::iter::once(&self.engine)
+            .chain(&self.members)
+            .enumerate()
+        {
+            let suffix = if k == 0 {
+                String::new()
+            } else {
+                format!("_member{}", k + 1)
+            };
+            match e {
+                Engine::Net(net) => {
+                    write_weights(&dir.join(format!("weights{suffix}.bin")), &net.params.value)?
+                }
+                Engine::Classical(c) => {
+                    let bytes = c.to_bytes();
+                    crate::io::write_atomic(&dir.join(format!("model{suffix}.bin")), |w| {
+                        w.write_all(&bytes)
+                    })?
+                }
             }
         }
+        Ok(())
     }
 
     /// Reads a model directory.
@@ -155,56 +211,76 @@ impl Model {
             file: path.clone(),
             message: e.to_string(),
         })?;
-        let engine = if meta.kind.architecture().is_some() {
-            let config = meta
-                .net
-                .clone()
-                .ok_or_else(|| Error::config(&path, "net", "missing for a network"))?;
-            // Sizes from the file: bounded before anything is allocated from them.
-            for (field, v, max) in [
-                ("net.window", config.window, 100_000),
-                ("net.channels", config.channels, 10_000),
-                ("net.outputs", config.outputs, 64),
-            ] {
-                if v == 0 || v > max {
-                    return Err(Error::config(
-                        &path,
-                        field,
-                        format!("{v} is outside 1..={max}"),
-                    ));
-                }
-            }
-            let mut net = Network::new(config);
-            if meta.slots.as_ref() != Some(&net.params.slots) {
+        if !(1..=32).contains(&meta.members) {
+            return Err(Error::config(
+                &path,
+                "members",
+                format!("{} is outside 1..=32", meta.members),
+            ));
+        }
+        let engine = read_engine(dir, &path, &meta, "")?;
+        let members = (2..=meta.members)
+            .map(|k| read_engine(dir, &path, &meta, &format!("_member{k}")))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Model {
+            meta,
+            engine,
+            members,
+        })
+    }
+}
+
+/// One member's engine from `dir` (`suffix` "" for the first, `_member<k>` for the others).
+fn read_engine(dir: &Path, path: &Path, meta: &ModelMeta, suffix: &str) -> Result<Engine> {
+    let engine = if meta.kind.architecture().is_some() {
+        let config = meta
+            .net
+            .clone()
+            .ok_or_else(|| Error::config(&path, "net", "missing for a network"))?;
+        // Sizes from the file: bounded before anything is allocated from them.
+        for (field, v, max) in [
+            ("net.window", config.window, 100_000),
+            ("net.channels", config.channels, 10_000),
+            ("net.outputs", config.outputs, 64),
+        ] {
+            if v == 0 || v > max {
                 return Err(Error::config(
                     &path,
-                    "slots",
-                    "weight layout differs from this version's network",
+                    field,
+                    format!("{v} is outside 1..={max}"),
                 ));
             }
-            let values = read_weights(&dir.join("weights.bin"))?;
-            if values.len() != net.params.value.len() {
-                return Err(Error::config(
-                    &dir.join("weights.bin"),
-                    "values",
-                    format!(
-                        "{} weights, the network has {}",
-                        values.len(),
-                        net.params.value.len()
-                    ),
-                ));
-            }
-            net.params.value = values;
-            Engine::Net(Box::new(net))
-        } else {
-            let p = dir.join("model.bin");
-            let bytes = std::fs::read(&p).map_err(|e| Error::io(&p, e))?;
-            Engine::Classical(Box::new(
-                Classical::from_bytes(&bytes).map_err(|m| Error::config(&p, "model", &m))?,
-            ))
-        };
-        Ok(Model { meta, engine })
-    }
+        }
+        let mut net = Network::new(config);
+        if meta.slots.as_ref() != Some(&net.params.slots) {
+            return Err(Error::config(
+                &path,
+                "slots",
+                "weight layout differs from this version's network",
+            ));
+        }
+        let values = read_weights(&dir.join(format!("weights{suffix}.bin")))?;
+        if values.len() != net.params.value.len() {
+            return Err(Error::config(
+                &dir.join(format!("weights{suffix}.bin")),
+                "values",
+                format!(
+                    "{} weights, the network has {}",
+                    values.len(),
+                    net.params.value.len()
+                ),
+            ));
+        }
+        net.params.value = values;
+        Engine::Net(Box::new(net))
+    } else {
+        let p = dir.join(format!("model{suffix}.bin"));
+        let bytes = std::fs::read(&p).map_err(|e| Error::io(&p, e))?;
+        Engine::Classical(Box::new(
+            Classical::from_bytes(&bytes).map_err(|m| Error::config(&p, "model", &m))?,
+        ))
+    };
+    Ok(engine)
 }
 
 /// Writes f32 values: magic, count (u64 LE), values (f32 LE).

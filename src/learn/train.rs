@@ -217,6 +217,8 @@ pub fn train(
         data_identity: identity,
         training: json!({}),
         version: env!("CARGO_PKG_VERSION").to_string(),
+        members: 1,
+        calibration: None,
     };
     let engine = match kind.architecture() {
         Some(architecture) => {
@@ -290,7 +292,11 @@ pub fn train(
         };
         obj.insert("options".into(), settings);
     }
-    let model = Model { meta, engine };
+    let model = Model {
+        meta,
+        engine,
+        members: Vec::new(),
+    };
     model.save(out)?;
     Ok(model)
 }

@@ -122,6 +122,21 @@ pub struct Traces {
     pub q: Vec<f64>,
     /// |Y|/Q (`null` where Q ≤ 0).
     pub y_over_q: Vec<Option<f64>>,
+    /// Identified forces only: the interval `identify` wrote around Y and Q, kN, as
+    /// `[lower, upper]` (`null` where the file has none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub band: Option<Band>,
+}
+
+/// The interval around identified Y and Q, kN (NaN where absent; drawn as a shaded band).
+#[derive(Debug, Clone, Serialize)]
+pub struct Band {
+    /// Lower and upper bound of Y.
+    pub y: [Vec<f64>; 2],
+    /// Lower and upper bound of Q.
+    pub q: [Vec<f64>; 2],
+    /// Nominal coverage where the file says it (`identify --coverage`), else `null`.
+    pub coverage: Option<f64>,
 }
 
 /// Limits drawn on the traces.
@@ -287,6 +302,7 @@ impl Scene {
             y: pick(fy, 1e-3, 2),
             q: pick(fq, 1e-3, 2),
             y_over_q: rows.iter().map(|&i| y_over_q(fy[i], fq[i])).collect(),
+            band: None,
         };
         let (identified, identified_source) = match &inp.identified {
             Some((src, id)) => {
@@ -317,6 +333,24 @@ impl Scene {
                         .collect()
                 };
                 let (sy, sq) = (series(iy), series(iq));
+                let bound = |comp: char, which: &str| {
+                    let name = format!("w{label_key}_force_{comp}_{which}_N");
+                    id.iter()
+                        .find(|(n, _)| *n == name)
+                        .map(|(_, v)| v.as_slice())
+                };
+                let kn = |c: Option<&[f64]>| -> Vec<f64> {
+                    series(c)
+                        .iter()
+                        .map(|x| x.map_or(f64::NAN, |x| round(x * 1e-3, 2)))
+                        .collect()
+                };
+                let band =
+                    (bound('y', "lo").is_some() || bound('z', "lo").is_some()).then(|| Band {
+                        y: [kn(bound('y', "lo")), kn(bound('y', "hi"))],
+                        q: [kn(bound('z', "lo")), kn(bound('z', "hi"))],
+                        coverage: None,
+                    });
                 // Y/Q needs both; with one identified, the true other stands in (said on the
                 // page).
                 let tr = Traces {
@@ -337,6 +371,7 @@ impl Scene {
                             y_over_q(y, q)
                         })
                         .collect(),
+                    band,
                 };
                 let what = match (iy.is_some(), iq.is_some()) {
                     (true, true) => "Y and Q identified",

@@ -258,8 +258,11 @@ pub fn streaming_latency_us(samples: usize) -> f64 {
             data_identity: serde_json::Value::Null,
             training: serde_json::Value::Null,
             version: String::new(),
+            members: 1,
+            calibration: None,
         },
         engine: Engine::Net(Box::new(net)),
+        members: Vec::new(),
     };
     let mut st = railforce::identify::Streamer::new(&mut model);
     let row: Vec<f64> = (0..21).map(|k| (k as f64 * 0.3).sin()).collect();
