@@ -256,6 +256,7 @@ mod tests {
             rows.push((c.to_string(), 1, i as f64 * 0.005, pairs));
         }
         let ev = Evaluation {
+            half_widths: None,
             metrics: metrics(&y, &p, &stats),
             windows_per_s: 0.0,
             rows,

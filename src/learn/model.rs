@@ -236,7 +236,7 @@ fn read_engine(dir: &Path, path: &Path, meta: &ModelMeta, suffix: &str) -> Resul
         let config = meta
             .net
             .clone()
-            .ok_or_else(|| Error::config(&path, "net", "missing for a network"))?;
+            .ok_or_else(|| Error::config(path, "net", "missing for a network"))?;
         // Sizes from the file: bounded before anything is allocated from them.
         for (field, v, max) in [
             ("net.window", config.window, 100_000),
@@ -245,7 +245,7 @@ fn read_engine(dir: &Path, path: &Path, meta: &ModelMeta, suffix: &str) -> Resul
         ] {
             if v == 0 || v > max {
                 return Err(Error::config(
-                    &path,
+                    path,
                     field,
                     format!("{v} is outside 1..={max}"),
                 ));
@@ -254,7 +254,7 @@ fn read_engine(dir: &Path, path: &Path, meta: &ModelMeta, suffix: &str) -> Resul
         let mut net = Network::new(config);
         if meta.slots.as_ref() != Some(&net.params.slots) {
             return Err(Error::config(
-                &path,
+                path,
                 "slots",
                 "weight layout differs from this version's network",
             ));
