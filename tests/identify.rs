@@ -186,3 +186,141 @@ fn ensemble_bands_are_ordered_finite_and_survive_a_round_trip() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Every channel the recorder writes for the C80 has the unit `sim::output::unit_of` gives its
+/// name (the channel map converts to it).
+#[test]
+fn unit_of_agrees_with_the_recorder() {
+    let v = railforce::vehicle::Vehicle::load(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("vehicles/c80.toml"),
+    )
+    .unwrap();
+    let track = railforce::sim::checks::smooth_tangent(300.0);
+    let sim = railforce::sim::Simulation::new(&v, &track, Default::default()).unwrap();
+    let rec = railforce::sim::Recorder::new(&sim);
+    assert!(rec.names().len() > 200);
+    for (n, u) in rec.names().iter().zip(rec.units()) {
+        assert_eq!(railforce::sim::output::unit_of(n), Some(*u), "{n}");
+        assert_eq!(
+            railforce::sim::output::unit_of(&format!("{n}_noisy")),
+            Some(*u)
+        );
+    }
+    assert_eq!(railforce::sim::output::unit_of("wagon_speed"), None);
+}
+
+/// A field recording with its own names, units (g, deg/s), signs and a time column in ms,
+/// read through a channel map, identifies the same forces as the recording in railforce's
+/// names and units; a missing column, a unit that does not convert, an unknown unit and a
+/// channel the model does not read are errors naming the map, the channel and the column.
+#[test]
+fn channel_map_reads_a_field_recording() {
+    use railforce::identify::ChannelMap;
+    let rows = 600;
+    let names: Vec<String> = ["time_s", "ws1_acc_y", "body_yaw_rate", "w1l_force_y"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let a: Vec<f64> = (0..rows).map(|t| 2.0 * (0.05 * t as f64).sin()).collect();
+    let b: Vec<f64> = (0..rows).map(|t| 0.01 * (0.021 * t as f64).cos()).collect();
+    let y: Vec<f64> = (0..rows)
+        .map(|t| 1000.0 * a[t] * b[t.saturating_sub(2)] * 50.0)
+        .collect();
+    let time: Vec<f64> = (0..rows).map(|t| t as f64 * 0.005).collect();
+    let ds = DataSet::in_memory(
+        &PathBuf::from("synthetic"),
+        names.clone(),
+        vec![Run {
+            condition: "c".into(),
+            seed: 1,
+            columns: vec![time.clone(), a.clone(), b.clone(), y],
+        }],
+    );
+    let spec = DataSpec {
+        channels: vec!["ws1_acc_y".into(), "body_yaw_rate".into()],
+        targets: vec!["w1l_force_y".into()],
+        window: 6,
+        label_at: LabelAt::Centre,
+        stride: 1,
+        split: Split::default(),
+        noise: NoiseProtocol::Clean,
+        noise_model: None,
+    };
+    let dir = std::env::temp_dir().join(format!("railforce-chmap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let opts = TrainOptions {
+        epochs: 2,
+        batch: 32,
+        ..TrainOptions::default()
+    };
+    let mut m = train(
+        &ds,
+        &spec,
+        ModelKind::Gru,
+        &opts,
+        &dir.join("m"),
+        &mut |_| {},
+    )
+    .unwrap();
+    let plain = check(&table(&ds), &m, false).unwrap();
+    let want = identify(&mut m, &plain);
+    // The field recording: other names, g and deg/s, the lateral axis flipped, time in ms.
+    let mut csv = String::from("Time,LAT_ACC,GYRO_Z\n");
+    for t in 0..rows {
+        csv += &format!(
+            "{},{},{}\n",
+            time[t] * 1000.0,
+            -a[t] / 9.80665,
+            b[t].to_degrees()
+        );
+    }
+    let rec = dir.join("field.csv");
+    std::fs::write(&rec, csv).unwrap();
+    let map_text = "time = { column = \"Time\", unit = \"ms\" }\n[channels]\nws1_acc_y = { column = \"LAT_ACC\", unit = \"g\", sign = -1 }\nbody_yaw_rate = { column = \"GYRO_Z\", unit = \"deg/s\" }\n";
+    let map_path = dir.join("map.toml");
+    std::fs::write(&map_path, map_text).unwrap();
+    let map = ChannelMap::load(&map_path).unwrap();
+    let field = map.read(&rec, &m.meta.data.channels).unwrap();
+    let input = check(&field, &m, false).unwrap();
+    let got = identify(&mut m, &input);
+    assert_eq!(got.time.len(), want.time.len());
+    for (g, w) in got.values.iter().zip(&want.values) {
+        assert!(
+            (g[0] - w[0]).abs() < 1e-3 * w[0].abs().max(1.0),
+            "{} vs {}",
+            g[0],
+            w[0]
+        );
+    }
+    // Errors name the map, the channel and the column.
+    for (text, says) in [
+        (
+            map_text.replace("GYRO_Z", "GYRO_X"),
+            "channels.body_yaw_rate",
+        ),
+        (
+            map_text.replace("unit = \"deg/s\"", "unit = \"g\""),
+            "does not convert to the channel's rad/s",
+        ),
+        (
+            map_text.replace("unit = \"deg/s\"", "unit = \"furlong\""),
+            "unknown unit \"furlong\"",
+        ),
+        (
+            map_text.replace(
+                "[channels]\n",
+                "[channels]\nws2_acc_y = { column = \"LAT_ACC\" }\n",
+            ),
+            "does not read this channel",
+        ),
+    ] {
+        std::fs::write(&map_path, &text).unwrap();
+        let e = ChannelMap::load(&map_path)
+            .and_then(|m2| m2.read(&rec, &m.meta.data.channels))
+            .err()
+            .unwrap_or_else(|| panic!("accepted: {text}"))
+            .to_string();
+        assert!(e.contains("map.toml") && e.contains(says), "{e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -87,10 +87,15 @@ pub struct IdentifyArgs {
     resample: bool,
     /// Coverage of the interval written around every identified force (`<target>_lo_N`,
     /// `<target>_hi_N`): split conformal on the model's validation runs, widened where an
-    /// ensemble's members disagree (`train --ensemble N`). Not for streamed input (`-`) or a
-    /// model trained before calibration existed.
+    /// ensemble's members disagree (`train --ensemble N`); streamed input gets them too. Not
+    /// for a model trained before calibration existed.
     #[arg(long, default_value_t = 0.9)]
     coverage: f64,
+    /// Channel map (TOML) for a recording with its own column names, units (g, mm, deg,
+    /// mrad/s …) and axis signs: each model channel's column, unit and sign, and the time
+    /// column (assets/docs/file-formats.md, "Channel maps"). Recorded in OUT.safety.json.
+    #[arg(long)]
+    channel_map: Option<PathBuf>,
     #[command(flatten)]
     limits: LimitArgs,
 }
@@ -98,10 +103,27 @@ pub struct IdentifyArgs {
 pub fn run(args: IdentifyArgs) -> Result<()> {
     let mut model = Model::load(&args.model)?;
     let limits = args.limits.limits()?;
-    if args.input.as_os_str() == "-" {
-        return stream(&mut model, &args.out, &limits);
+    if !(args.coverage > 0.0 && args.coverage < 1.0) {
+        bail!(
+            "--coverage {}: give a fraction between 0 and 1, e.g. 0.9",
+            args.coverage
+        );
     }
-    let table = SensorTable::read(&args.input)?;
+    let map = args
+        .channel_map
+        .as_deref()
+        .map(railforce::identify::ChannelMap::load)
+        .transpose()?;
+    if args.input.as_os_str() == "-" {
+        if map.is_some() {
+            bail!("--channel-map reads a file: give --input a recording, not - (a stream)");
+        }
+        return stream(&mut model, &args.out, &limits, args.coverage);
+    }
+    let table = match &map {
+        Some(m) => m.read(&args.input, &model.meta.data.channels)?,
+        None => SensorTable::read(&args.input)?,
+    };
     let input = check(&table, &model, args.resample).map_err(|e| {
         if args.resample {
             anyhow::anyhow!(e)
@@ -150,7 +172,7 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
         std::io::stdout().write_all(s.as_bytes())?;
     } else {
         railforce::io::write_atomic(&args.out, |w| w.write_all(s.as_bytes()))?;
-        let sp = write_safety_json(&args.out, &reports, &limits)?;
+        let sp = write_safety_json(&args.out, &reports, &limits, map.as_ref())?;
         eprintln!(
             "identified {} estimates of {} from {} ({} channels: {}) in {:.3} s; wrote {} and {}",
             id.time.len(),
@@ -230,12 +252,21 @@ fn row(
 }
 
 /// Writes `OUT.safety.json` (limits and every index's report) beside the output.
-fn write_safety_json(out: &Path, reports: &[IndexReport], limits: &Limits) -> Result<PathBuf> {
-    let json = serde_json::to_string_pretty(&serde_json::json!({
+fn write_safety_json(
+    out: &Path,
+    reports: &[IndexReport],
+    limits: &Limits,
+    map: Option<&railforce::identify::ChannelMap>,
+) -> Result<PathBuf> {
+    let mut doc = serde_json::json!({
         "limits": limits,
         "limits_source": "commonly quoted Chinese values (secondary sources, assets/docs/physics.md §7)",
         "indices": reports,
-    }))?;
+    });
+    if let Some(m) = map {
+        doc["channel_map"] = m.describe();
+    }
+    let json = serde_json::to_string_pretty(&doc)?;
     let sp = out.with_extension("safety.json");
     railforce::io::write_atomic(&sp, |w| w.write_all(json.as_bytes()))?;
     Ok(sp)
@@ -279,7 +310,7 @@ pub fn print_safety(reports: &[IndexReport], limits: &Limits) {
 /// Streams CSV lines from standard input; writes each estimate, with the track position and
 /// the safety indices, as soon as its window is full (the same row text as a batch run), and
 /// the exceedance report at the end of the stream.
-fn stream(model: &mut Model, out: &Path, limits: &Limits) -> Result<()> {
+fn stream(model: &mut Model, out: &Path, limits: &Limits, coverage: f64) -> Result<()> {
     let mut rows = SensorRows::new(std::io::stdin().lock(), "stdin", model)?;
     let has_position = rows.has_position();
     let spec = model.meta.data.clone();
@@ -291,7 +322,8 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits) -> Result<()> {
         ))
     };
     let mut monitor = Monitor::new(&spec.targets, limits, false);
-    w.write_all(header(&spec.targets, has_position, false, &monitor.columns()).as_bytes())?;
+    let banded = model.meta.calibration.is_some();
+    w.write_all(header(&spec.targets, has_position, banded, &monitor.columns()).as_bytes())?;
     let off = railforce::learn::windows::label_offset(spec.window, spec.label_at);
     let mut positions = std::collections::VecDeque::with_capacity(spec.window);
     let mut st = Streamer::new(model);
@@ -303,16 +335,16 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits) -> Result<()> {
                 positions.pop_front();
             }
         }
-        if let Some((tl, f)) = st.push(t, &values) {
+        if let Some((tl, f, band)) = st.push_with_bands(t, &values, Some(coverage)) {
             let idx = monitor.push(tl, &f);
             let p = has_position.then(|| positions[off]);
-            w.write_all(row(tl, p, &f, None, &idx).as_bytes())?;
+            w.write_all(row(tl, p, &f, band.as_deref(), &idx).as_bytes())?;
             w.flush()?;
         }
     }
     let reports = monitor.finish();
     if out.as_os_str() != "-" {
-        let sp = write_safety_json(out, &reports, limits)?;
+        let sp = write_safety_json(out, &reports, limits, None)?;
         eprintln!("wrote {} and {}", out.display(), sp.display());
     }
     print_safety(&reports, limits);

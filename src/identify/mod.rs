@@ -4,12 +4,14 @@
 //! Y/Q, wheel unloading and wheelset lateral force with an exceedance report. [`Streamer`]
 //! does the same one sample at a time.
 
+pub mod channel_map;
 pub mod check_report;
 pub mod closed_loop;
 mod stream;
 /// The safety indices live in [`crate::assess::safety`] (assess judges any force series);
 /// re-exported here, where the streaming identification uses them.
 pub use crate::assess::safety;
+pub use channel_map::ChannelMap;
 pub use stream::SensorRows;
 
 use crate::error::{Error, Result};
@@ -307,21 +309,14 @@ pub fn identify_with_bands(
         }
     }
     let bands = match (coverage, &model.meta.calibration) {
-        (Some(cov), Some(cal)) => {
+        (Some(cov), Some(_)) => {
             let o = spec.targets.len();
-            let ts = &model.meta.target_stats;
             Some(Bands {
                 coverage: cov,
                 bounds: (0..count)
                     .map(|s| {
-                        (0..o)
-                            .map(|k| {
-                                let sp = spread.get(s * o + k).copied().unwrap_or(0.0) as f64;
-                                let h = cal.half_width(k, cov, sp) * ts.std[k];
-                                let v = out[s * o + k] as f64 * ts.std[k] + ts.mean[k];
-                                (v - h, v + h)
-                            })
-                            .collect()
+                        let sp = (!spread.is_empty()).then(|| &spread[s * o..(s + 1) * o]);
+                        bounds(model, &out[s * o..(s + 1) * o], sp, cov)
                     })
                     .collect(),
             })
@@ -329,6 +324,21 @@ pub fn identify_with_bands(
         _ => None,
     };
     (finish(model, &input.time, out, count), bands)
+}
+
+/// The interval (N) around one estimate: its standardised prediction `mean` and the members'
+/// `spread` per target, at `coverage` (the model must be calibrated).
+fn bounds(model: &Model, mean: &[f32], spread: Option<&[f32]>, coverage: f64) -> Vec<(f64, f64)> {
+    let cal = model.meta.calibration.as_ref().expect("a calibrated model");
+    let ts = &model.meta.target_stats;
+    (0..mean.len())
+        .map(|k| {
+            let sp = spread.map_or(0.0, |s| s[k] as f64);
+            let h = cal.half_width(k, coverage, sp) * ts.std[k];
+            let v = mean[k] as f64 * ts.std[k] + ts.mean[k];
+            (v - h, v + h)
+        })
+        .collect()
 }
 
 fn finish(model: &Model, time: &[f64], out: Vec<f32>, count: usize) -> Identified {
@@ -384,6 +394,21 @@ impl<'a> Streamer<'a> {
     /// # Panics
     /// When `values` does not hold one value per model channel.
     pub fn push(&mut self, time: f64, values: &[f64]) -> Option<(f64, Vec<f64>)> {
+        self.push_with_bands(time, values, None)
+            .map(|(t, v, _)| (t, v))
+    }
+
+    /// [`Streamer::push`], and with `coverage` the interval (N) around each force where the
+    /// model is calibrated: the same numbers as [`identify_with_bands`] on the whole record.
+    ///
+    /// # Panics
+    /// When `values` does not hold one value per model channel.
+    pub fn push_with_bands(
+        &mut self,
+        time: f64,
+        values: &[f64],
+        coverage: Option<f64>,
+    ) -> Option<(f64, Vec<f64>, Option<Vec<(f64, f64)>>)> {
         let spec = &self.model.meta.data;
         let (w, c) = (spec.window, spec.channels.len());
         assert_eq!(
@@ -409,11 +434,15 @@ impl<'a> Streamer<'a> {
         self.x.clear();
         self.x.extend(self.ring.iter());
         let x = std::mem::take(&mut self.x);
-        let out = self.model.predict(&x, 1);
+        let (out, spread) = self.model.predict_spread(&x, 1);
         self.x = x;
+        let band = match (coverage, &self.model.meta.calibration) {
+            (Some(c), Some(_)) => Some(bounds(self.model, &out, spread.as_deref(), c)),
+            _ => None,
+        };
         let times: Vec<f64> = self.times.iter().copied().collect();
         let id = finish(self.model, &times, out, 1);
-        Some((id.time[0], id.values[0].clone()))
+        Some((id.time[0], id.values[0].clone(), band))
     }
 
     /// Label position of the model (estimates lag the newest sample by `window − 1 − offset`

@@ -420,3 +420,36 @@ pub fn meta_path(out: &Path) -> PathBuf {
         .unwrap_or_else(|| "run".into());
     out.with_file_name(format!("{stem}.meta.json"))
 }
+
+/// The SI unit of a recorded channel from its name, by the same tables the recorder names its
+/// channels with (`time_s`, `s_m`, the paper's 21, `w<wheel>_<signal>`, `<body>_<signal>`, the
+/// suspension gauges); a `_noisy` copy has its channel's unit; `None` for a name it never
+/// records.
+pub fn unit_of(name: &str) -> Option<&'static str> {
+    let n = crate::sensors::clean_name(name);
+    match n {
+        "time_s" => return Some("s"),
+        "s_m" => return Some("m"),
+        _ => {}
+    }
+    if let Some(k) = PAPER_CHANNELS.iter().position(|c| *c == n) {
+        return Some(PAPER_UNITS[k]);
+    }
+    let wheel = n.len() > 4
+        && n.starts_with('w')
+        && n.as_bytes()[1].is_ascii_digit()
+        && matches!(n.as_bytes()[2], b'l' | b'r')
+        && n.as_bytes()[3] == b'_';
+    if wheel && let Some((_, u)) = WHEEL_SIGNALS.iter().find(|(s, _)| &n[4..] == *s) {
+        return Some(u);
+    }
+    if let Some((_, u)) = BODY_SIGNALS.iter().find(|(s, _)| {
+        n.len() > s.len() + 1 && n.ends_with(s) && n.as_bytes()[n.len() - s.len() - 1] == b'_'
+    }) {
+        return Some(u);
+    }
+    crate::sensors::DEFLECTION_PREFIXES
+        .iter()
+        .any(|p| n.starts_with(p))
+        .then_some("m")
+}
