@@ -368,6 +368,10 @@ pub fn at_labels(model: &Model, series: &[f64]) -> Vec<f64> {
     (0..count).map(|s| series[s + off]).collect()
 }
 
+/// One streamed estimate: label time (s), forces (N) and, where asked and calibrated, each
+/// force's interval (N).
+pub type Estimate = (f64, Vec<f64>, Option<Vec<(f64, f64)>>);
+
 /// One-sample-at-a-time identification: keeps the last `window` standardised samples and
 /// answers as soon as a window is complete.
 pub struct Streamer<'a> {
@@ -408,7 +412,7 @@ impl<'a> Streamer<'a> {
         time: f64,
         values: &[f64],
         coverage: Option<f64>,
-    ) -> Option<(f64, Vec<f64>, Option<Vec<(f64, f64)>>)> {
+    ) -> Option<Estimate> {
         let spec = &self.model.meta.data;
         let (w, c) = (spec.window, spec.channels.len());
         assert_eq!(
