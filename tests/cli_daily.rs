@@ -84,7 +84,7 @@ fn identify_both_wheels_streaming_equals_batch() {
          w1l_force_z_N,w1l_force_z_lo_N,w1l_force_z_hi_N,\
          w1r_force_y_N,w1r_force_y_lo_N,w1r_force_y_hi_N,\
          w1r_force_z_N,w1r_force_z_lo_N,w1r_force_z_hi_N,\
-         y_over_q_w1l,unloading_w1l,y_over_q_w1r,unloading_w1r,h_wheelset1_kn"
+         y_over_q_w1l,unloading_w1l,y_over_q_w1r,unloading_w1r,h_wheelset1_kn,ood_channels"
     );
     assert!(a.is_ascii());
     assert_eq!(a, b, "streaming and batch write the same file");

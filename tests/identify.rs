@@ -324,3 +324,47 @@ fn channel_map_reads_a_field_recording() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The out-of-distribution flag stays quiet on inputs like the training runs and fires where a
+/// channel is planted off its range, naming that channel and only that stretch.
+#[test]
+fn ood_flag_fires_on_a_planted_offset_and_stays_quiet_otherwise() {
+    use railforce::identify::out_of_distribution;
+    use railforce::learn::uncertainty::train_ensemble;
+    let ds = synthetic(600);
+    let spec = DataSpec {
+        channels: vec!["a".into(), "b".into()],
+        targets: vec!["w1l_force_y".into()],
+        window: 6,
+        label_at: LabelAt::Centre,
+        stride: 1,
+        split: Split::default(),
+        noise: NoiseProtocol::Clean,
+        noise_model: None,
+    };
+    let out = std::env::temp_dir().join(format!("railforce-ood-{}", std::process::id()));
+    let opts = TrainOptions {
+        epochs: 2,
+        batch: 32,
+        ..TrainOptions::default()
+    };
+    let m = train_ensemble(&ds, &spec, ModelKind::Gru, &opts, 1, &out, &mut |_, _| {}).unwrap();
+    assert_eq!(m.meta.calibration.as_ref().unwrap().envelope.len(), 2);
+    let quiet = out_of_distribution(&m, &check(&table(&ds), &m, false).unwrap()).unwrap();
+    assert_eq!(quiet.share(), 0.0, "in distribution: no flag");
+    // Channel a (a sine of amplitude 1) shifted by 3 from row 300 to 349.
+    let mut t = table(&ds);
+    let a = t.columns.iter_mut().find(|(n, _)| n == "a").unwrap();
+    for v in &mut a.1[300..350] {
+        *v += 3.0;
+    }
+    let input = check(&t, &m, false).unwrap();
+    let ood = out_of_distribution(&m, &input).unwrap();
+    let time: Vec<f64> = (0..ood.channels.len()).map(|i| i as f64).collect();
+    let spans = ood.spans(&time, &m.meta.data.channels);
+    assert_eq!(spans.len(), 1, "{spans:?}");
+    assert_eq!(spans[0].channels, vec!["a".to_string()]);
+    // Windows of 6 that hold any of rows 300–349 start at 295–349.
+    assert_eq!((spans[0].from_s, spans[0].to_s), (295.0, 349.0));
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -131,12 +131,6 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
             anyhow::anyhow!("{e}; --resample interpolates a record onto the model's rate")
         }
     })?;
-    if !(args.coverage > 0.0 && args.coverage < 1.0) {
-        bail!(
-            "--coverage {}: give a fraction between 0 and 1, e.g. 0.9",
-            args.coverage
-        );
-    }
     let t0 = std::time::Instant::now();
     let (id, bands) = identify_with_bands(&mut model, &input, Some(args.coverage));
     let secs = t0.elapsed().as_secs_f64();
@@ -151,11 +145,13 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
         .as_ref()
         .map(|p| railforce::identify::at_labels(&model, p));
     let mut monitor = Monitor::new(&id.targets, &limits, false);
+    let ood = railforce::identify::out_of_distribution(&model, &input);
     let mut s = header(
         &id.targets,
         position.is_some(),
         bands.is_some(),
         &monitor.columns(),
+        ood.is_some(),
     );
     for (i, t) in id.time.iter().enumerate() {
         let idx = monitor.push(*t, &id.values[i]);
@@ -165,14 +161,18 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
             &id.values[i],
             bands.as_ref().map(|b| b.bounds[i].as_slice()),
             &idx,
+            ood.as_ref().map(|o| o.channels[i].len()),
         );
     }
+    let spans = ood
+        .as_ref()
+        .map(|o| (o.share(), o.spans(&id.time, &model.meta.data.channels)));
     let reports = monitor.finish();
     if args.out.as_os_str() == "-" {
         std::io::stdout().write_all(s.as_bytes())?;
     } else {
         railforce::io::write_atomic(&args.out, |w| w.write_all(s.as_bytes()))?;
-        let sp = write_safety_json(&args.out, &reports, &limits, map.as_ref())?;
+        let sp = write_safety_json(&args.out, &reports, &limits, map.as_ref(), spans.as_ref())?;
         eprintln!(
             "identified {} estimates of {} from {} ({} channels: {}) in {:.3} s; wrote {} and {}",
             id.time.len(),
@@ -203,12 +203,44 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
         }
     }
     print_safety(&reports, &limits);
+    print_ood(spans.as_ref());
     Ok(())
+}
+
+/// The out-of-distribution report on standard error.
+fn print_ood(spans: Option<&(f64, Vec<railforce::identify::OodSpan>)>) {
+    let Some((share, spans)) = spans else {
+        return;
+    };
+    if spans.is_empty() {
+        eprintln!(
+            "inputs within what the model was trained on throughout (training envelope ± 25 %)"
+        );
+        return;
+    }
+    eprintln!(
+        "OUT OF DISTRIBUTION: {:.1} % of the estimates read inputs beyond the training envelope (± 25 %); their forces are extrapolated:",
+        share * 100.0
+    );
+    for s in spans.iter().take(20) {
+        eprintln!(
+            "    {:.3} s to {:.3} s: {}",
+            s.from_s,
+            s.to_s,
+            s.channels.join(", ")
+        );
+    }
+    if spans.len() > 20 {
+        eprintln!(
+            "    … {} more stretches in the .safety.json",
+            spans.len() - 20
+        );
+    }
 }
 
 /// Header of identify's output: time, the track position when the input has it, each target's
 /// force in N (with its interval's bounds when `bands`), then each safety index (ASCII names).
-fn header(targets: &[String], position: bool, bands: bool, indices: &[&str]) -> String {
+fn header(targets: &[String], position: bool, bands: bool, indices: &[&str], ood: bool) -> String {
     let mut s = String::from("time_s");
     if position {
         s.push_str(",s_m");
@@ -222,6 +254,9 @@ fn header(targets: &[String], position: bool, bands: bool, indices: &[&str]) -> 
     for c in indices {
         let _ = write!(s, ",{c}");
     }
+    if ood {
+        s.push_str(",ood_channels");
+    }
     s.push('\n');
     s
 }
@@ -233,6 +268,7 @@ fn row(
     forces: &[f64],
     bounds: Option<&[(f64, f64)]>,
     indices: &[f64],
+    ood: Option<usize>,
 ) -> String {
     let mut s = format!("{:.3}", railforce::identify::safety::on_grid(t));
     if let Some(p) = position {
@@ -247,6 +283,9 @@ fn row(
     for v in indices {
         let _ = write!(s, ",{v:.4}");
     }
+    if let Some(n) = ood {
+        let _ = write!(s, ",{n}");
+    }
     s.push('\n');
     s
 }
@@ -257,6 +296,7 @@ fn write_safety_json(
     reports: &[IndexReport],
     limits: &Limits,
     map: Option<&railforce::identify::ChannelMap>,
+    ood: Option<&(f64, Vec<railforce::identify::OodSpan>)>,
 ) -> Result<PathBuf> {
     let mut doc = serde_json::json!({
         "limits": limits,
@@ -265,6 +305,13 @@ fn write_safety_json(
     });
     if let Some(m) = map {
         doc["channel_map"] = m.describe();
+    }
+    if let Some((share, spans)) = ood {
+        doc["out_of_distribution"] = serde_json::json!({
+            "rule": "an estimate whose window holds an input beyond the 0.1–99.9 % range of the training part widened by 25 % on each side",
+            "share": share,
+            "spans": spans,
+        });
     }
     let json = serde_json::to_string_pretty(&doc)?;
     let sp = out.with_extension("safety.json");
@@ -323,7 +370,22 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits, coverage: f64) -> Resu
     };
     let mut monitor = Monitor::new(&spec.targets, limits, false);
     let banded = model.meta.calibration.is_some();
-    w.write_all(header(&spec.targets, has_position, banded, &monitor.columns()).as_bytes())?;
+    let enveloped = model
+        .meta
+        .calibration
+        .as_ref()
+        .is_some_and(|c| !c.envelope.is_empty());
+    w.write_all(
+        header(
+            &spec.targets,
+            has_position,
+            banded,
+            &monitor.columns(),
+            enveloped,
+        )
+        .as_bytes(),
+    )?;
+    let (mut times, mut flagged) = (Vec::new(), Vec::new());
     let off = railforce::learn::windows::label_offset(spec.window, spec.label_at);
     let mut positions = std::collections::VecDeque::with_capacity(spec.window);
     let mut st = Streamer::new(model);
@@ -335,19 +397,27 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits, coverage: f64) -> Resu
                 positions.pop_front();
             }
         }
-        if let Some((tl, f, band)) = st.push_with_bands(t, &values, Some(coverage)) {
-            let idx = monitor.push(tl, &f);
+        if let Some(e) = st.push_with_bands(t, &values, Some(coverage)) {
+            let idx = monitor.push(e.time, &e.forces);
             let p = has_position.then(|| positions[off]);
-            w.write_all(row(tl, p, &f, band.as_deref(), &idx).as_bytes())?;
+            let n_out = e.outside.as_ref().map(|o| o.len());
+            w.write_all(row(e.time, p, &e.forces, e.bounds.as_deref(), &idx, n_out).as_bytes())?;
+            times.push(e.time);
+            flagged.push(e.outside.unwrap_or_default());
             w.flush()?;
         }
     }
     let reports = monitor.finish();
+    let spans = enveloped.then(|| {
+        let o = railforce::identify::OutOfDistribution { channels: flagged };
+        (o.share(), o.spans(&times, &spec.channels))
+    });
     if out.as_os_str() != "-" {
-        let sp = write_safety_json(out, &reports, limits, None)?;
+        let sp = write_safety_json(out, &reports, limits, None, spans.as_ref())?;
         eprintln!("wrote {} and {}", out.display(), sp.display());
     }
     print_safety(&reports, limits);
+    print_ood(spans.as_ref());
     Ok(())
 }
 

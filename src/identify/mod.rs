@@ -264,6 +264,106 @@ pub fn identify(model: &mut Model, input: &CheckedInput) -> Identified {
     identify_with_bands(model, input, None).0
 }
 
+/// How far beyond the training envelope (as a fraction of its width, on either side) an input
+/// may go before its estimate is flagged out of distribution.
+pub const OOD_MARGIN: f64 = 0.25;
+
+/// The input channels (indices in model order) of a standardised window `[steps × c]` that
+/// leave the calibration's training envelope by more than [`OOD_MARGIN`] anywhere in it.
+fn outside(envelope: &[[f64; 2]], window: &[f32], c: usize) -> Vec<usize> {
+    (0..c.min(envelope.len()))
+        .filter(|&k| {
+            let [lo, hi] = envelope[k];
+            let m = OOD_MARGIN * (hi - lo);
+            window
+                .iter()
+                .skip(k)
+                .step_by(c)
+                .any(|&v| (v as f64) < lo - m || (v as f64) > hi + m)
+        })
+        .collect()
+}
+
+/// Estimates whose inputs left what the model was trained on: per estimate, the input channels
+/// (model order) outside the training envelope.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutOfDistribution {
+    /// Per estimate, the channels outside (empty: in distribution).
+    pub channels: Vec<Vec<usize>>,
+}
+
+/// One stretch of flagged estimates.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct OodSpan {
+    /// First and last label time, s.
+    pub from_s: f64,
+    /// See `from_s`.
+    pub to_s: f64,
+    /// The channels outside somewhere in it.
+    pub channels: Vec<String>,
+}
+
+impl OutOfDistribution {
+    /// Contiguous stretches of flagged estimates with their channels' names.
+    pub fn spans(&self, time: &[f64], names: &[String]) -> Vec<OodSpan> {
+        let mut out: Vec<OodSpan> = Vec::new();
+        let mut open = false;
+        for (i, ch) in self.channels.iter().enumerate() {
+            if ch.is_empty() {
+                open = false;
+                continue;
+            }
+            if !open {
+                out.push(OodSpan {
+                    from_s: time[i],
+                    to_s: time[i],
+                    channels: Vec::new(),
+                });
+                open = true;
+            }
+            let span = out.last_mut().expect("opened");
+            span.to_s = time[i];
+            for &k in ch {
+                if !span.channels.contains(&names[k]) {
+                    span.channels.push(names[k].clone());
+                }
+            }
+        }
+        out
+    }
+
+    /// Share of estimates flagged.
+    pub fn share(&self) -> f64 {
+        self.channels.iter().filter(|c| !c.is_empty()).count() as f64
+            / self.channels.len().max(1) as f64
+    }
+}
+
+/// The out-of-distribution check of a whole recording against the model's training envelope
+/// (`None` for a model without one: trained before 2026-12-02).
+pub fn out_of_distribution(model: &Model, input: &CheckedInput) -> Option<OutOfDistribution> {
+    let env = &model.meta.calibration.as_ref()?.envelope;
+    if env.is_empty() {
+        return None;
+    }
+    let spec = &model.meta.data;
+    let (w, c) = (spec.window, spec.channels.len());
+    let n = input.time.len();
+    let z = &model.meta.input_stats;
+    let mut rows = vec![0.0f32; n * c];
+    for (k, col) in input.columns.iter().enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            rows[i * c + k] = z.apply(k, *v) as f32;
+        }
+    }
+    let count = (n + 1).saturating_sub(w);
+    Some(OutOfDistribution {
+        channels: (0..count)
+            .map(|s| outside(env, &rows[s * c..(s + w) * c], c))
+            .collect(),
+    })
+}
+
 /// Intervals around identified forces: per estimate and target, the lower and upper bound in
 /// N at `coverage` (split conformal on the model's validation runs, widened where an
 /// ensemble's members disagree; `learn::uncertainty`).
@@ -368,9 +468,19 @@ pub fn at_labels(model: &Model, series: &[f64]) -> Vec<f64> {
     (0..count).map(|s| series[s + off]).collect()
 }
 
-/// One streamed estimate: label time (s), forces (N) and, where asked and calibrated, each
-/// force's interval (N).
-pub type Estimate = (f64, Vec<f64>, Option<Vec<(f64, f64)>>);
+/// One streamed estimate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Estimate {
+    /// Label time, s.
+    pub time: f64,
+    /// Forces, N.
+    pub forces: Vec<f64>,
+    /// Each force's interval (N), where asked and the model is calibrated.
+    pub bounds: Option<Vec<(f64, f64)>>,
+    /// The input channels outside the training envelope in this window, where the model has
+    /// one.
+    pub outside: Option<Vec<usize>>,
+}
 
 /// One-sample-at-a-time identification: keeps the last `window` standardised samples and
 /// answers as soon as a window is complete.
@@ -399,7 +509,7 @@ impl<'a> Streamer<'a> {
     /// When `values` does not hold one value per model channel.
     pub fn push(&mut self, time: f64, values: &[f64]) -> Option<(f64, Vec<f64>)> {
         self.push_with_bands(time, values, None)
-            .map(|(t, v, _)| (t, v))
+            .map(|e| (e.time, e.forces))
     }
 
     /// [`Streamer::push`], and with `coverage` the interval (N) around each force where the
@@ -444,9 +554,21 @@ impl<'a> Streamer<'a> {
             (Some(c), Some(_)) => Some(bounds(self.model, &out, spread.as_deref(), c)),
             _ => None,
         };
+        let outside_env = self
+            .model
+            .meta
+            .calibration
+            .as_ref()
+            .filter(|cal| !cal.envelope.is_empty())
+            .map(|cal| outside(&cal.envelope, &self.x, c));
         let times: Vec<f64> = self.times.iter().copied().collect();
         let id = finish(self.model, &times, out, 1);
-        Some((id.time[0], id.values[0].clone(), band))
+        Some(Estimate {
+            time: id.time[0],
+            forces: id.values[0].clone(),
+            bounds: band,
+            outside: outside_env,
+        })
     }
 
     /// Label position of the model (estimates lag the newest sample by `window − 1 − offset`

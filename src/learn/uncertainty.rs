@@ -36,6 +36,10 @@ pub struct Calibration {
     pub windows: usize,
     /// What they were.
     pub part: String,
+    /// Per input channel, the 0.1 % and 99.9 % quantiles of its standardised values over the
+    /// training part: what the model has seen (`identify` flags inputs beyond it).
+    #[serde(default)]
+    pub envelope: Vec<[f64; 2]>,
 }
 
 impl Calibration {
@@ -98,6 +102,7 @@ impl Calibration {
             quantiles,
             windows: n,
             part,
+            envelope: Vec::new(),
         })
     }
 
@@ -137,7 +142,8 @@ pub fn calibrate(model: &mut Model, ds: &DataSet) -> Result<Calibration> {
         }
     }
     let runs: std::collections::BTreeSet<u32> = val.windows.iter().map(|w| w.run).collect();
-    Calibration::fit(
+    let envelope = envelope(&prep.train);
+    let mut cal = Calibration::fit(
         &y,
         &mean,
         (!spread.is_empty()).then_some(spread.as_slice()),
@@ -147,7 +153,33 @@ pub fn calibrate(model: &mut Model, ds: &DataSet) -> Result<Calibration> {
             val.len(),
             runs.len()
         ),
-    )
+    )?;
+    cal.envelope = envelope;
+    Ok(cal)
+}
+
+/// Windows sampled (evenly strided) for the input envelope.
+const ENVELOPE_WINDOWS: usize = 20_000;
+
+/// Per channel, the 0.1 % and 99.9 % quantiles of the standardised inputs over (evenly strided
+/// windows of) `train`.
+fn envelope(train: &super::windows::WindowSet) -> Vec<[f64; 2]> {
+    let c = train.channels;
+    let step = train.len().div_ceil(ENVELOPE_WINDOWS).max(1);
+    let idx: Vec<usize> = (0..train.len()).step_by(step).collect();
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    train.gather(&idx, &mut x, &mut y);
+    (0..c)
+        .map(|k| {
+            let mut v: Vec<f64> = x.iter().skip(k).step_by(c).map(|&v| v as f64).collect();
+            if v.is_empty() {
+                return [f64::NEG_INFINITY, f64::INFINITY];
+            }
+            v.sort_by(f64::total_cmp);
+            let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+            [q(0.001), q(0.999)]
+        })
+        .collect()
 }
 
 /// Trains `members` networks (or regressors) from seeds `opts.seed`, `opts.seed + 1`, …
