@@ -277,10 +277,17 @@ fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
         Some(noise),
         "the model records its SNR"
     );
+    model.meta.calibration =
+        Some(railforce::learn::uncertainty::calibrate(&mut model, &ds).unwrap());
     let work = dir.join("closed_loop");
     let limits = Limits::default();
     let checks = closed_loop::validate(&mut model, &plan, 1001, &work, 1, &limits, 0.2).unwrap();
     assert_eq!(checks.len(), 1);
+    // The calibrated interval's coverage and width on the fresh run, per target.
+    for t in &checks[0].targets {
+        let (c, w) = (t.coverage.unwrap(), t.width_kn.unwrap());
+        assert!((0.0..=1.0).contains(&c) && w > 0.0 && w.is_finite(), "{c} {w}");
+    }
     // The report: labelled JSON, tidy traces, a page whose every link resolves.
     let report = dir.join("report");
     let settings = railforce::identify::check_report::CheckSettings {

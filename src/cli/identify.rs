@@ -458,14 +458,21 @@ pub fn validate(
         &mut model, &plan, seed, &work, jobs, limits, margin,
     )?;
     println!(
-        "{:<22} {:<14} {:>7} {:>9} {:>12}",
-        "condition", "target", "R²", "RMSE kN", "peak err kN"
+        "{:<22} {:<14} {:>7} {:>9} {:>12} {:>13} {:>13}",
+        "condition", "target", "R²", "RMSE kN", "peak err kN", "90 % covers", "width kN"
     );
     for r in &runs {
         for t in &r.targets {
             println!(
-                "{:<22} {:<14} {:>7.3} {:>9.2} {:>12.2}",
-                r.condition, t.target, t.r2, t.rmse_kn, t.peak_error_kn
+                "{:<22} {:<14} {:>7.3} {:>9.2} {:>12.2} {:>13} {:>13}",
+                r.condition,
+                t.target,
+                t.r2,
+                t.rmse_kn,
+                t.peak_error_kn,
+                t.coverage
+                    .map_or("—".into(), |c| format!("{:.1} %", c * 100.0)),
+                t.width_kn.map_or("—".into(), |w| format!("{w:.2}"))
             );
         }
     }

@@ -95,7 +95,15 @@ fn write_traces(path: &Path, runs: &[RunCheck]) -> Result<()> {
 fn section(runs: &[RunCheck], s: &CheckSettings) -> Section {
     let f = |v: f64| format!("{v:.4}");
     let opt = |v: Option<f64>| v.map(|v| format!("{v:.3}")).unwrap_or(MISSING.into());
-    let mut fit = Table::new(&["condition", "target", "R²", "RMSE kN", "peak error kN"]);
+    let mut fit = Table::new(&[
+        "condition",
+        "target",
+        "R²",
+        "RMSE kN",
+        "peak error kN",
+        "90 % interval covers",
+        "mean width kN",
+    ]);
     let mut safety = Table::new(&[
         "condition",
         "index",
@@ -118,6 +126,9 @@ fn section(runs: &[RunCheck], s: &CheckSettings) -> Section {
                 f(t.r2),
                 format!("{:.2}", t.rmse_kn),
                 format!("{:.2}", t.peak_error_kn),
+                t.coverage
+                    .map_or(MISSING.into(), |c| format!("{:.1} %", c * 100.0)),
+                t.width_kn.map_or(MISSING.into(), |w| format!("{w:.2}")),
             ]);
         }
         for c in &r.safety {

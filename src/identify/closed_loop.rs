@@ -3,7 +3,7 @@
 //! R², RMSE, peak error and whether the safety verdicts agree.
 
 use super::safety::{Limits, indices};
-use super::{Identified, SensorTable, check, identify};
+use super::{Identified, SensorTable, check, identify_with_bands};
 use crate::dataset::DataSet;
 use crate::dataset::{Format, GenerateOptions, generate};
 use crate::error::{Error, Result};
@@ -25,6 +25,11 @@ pub struct TargetCheck {
     pub rmse_kn: f64,
     /// Largest absolute error, kN.
     pub peak_error_kn: f64,
+    /// Share of the true forces inside the model's interval at
+    /// [`crate::learn::evaluate::EVAL_COVERAGE`] (`None`: the model is not calibrated).
+    pub coverage: Option<f64>,
+    /// Mean width of that interval, kN.
+    pub width_kn: Option<f64>,
 }
 
 /// One safety index of one wheel (or wheelset) of a run: the identified value against the
@@ -180,7 +185,8 @@ pub fn validate(
         let table =
             SensorTable::from_columns(format!("{} seed {}", run.condition, run.seed), cols)?;
         let input = check(&table, model, false)?;
-        let id = identify(model, &input);
+        let (id, bands) =
+            identify_with_bands(model, &input, Some(crate::learn::evaluate::EVAL_COVERAGE));
         let truth_cols = model
             .meta
             .data
@@ -205,7 +211,25 @@ pub fn validate(
                 let mean = y.iter().sum::<f64>() / y.len() as f64;
                 let sst: f64 = y.iter().map(|v| (v - mean).powi(2)).sum();
                 let sse: f64 = y.iter().zip(&p).map(|(a, b)| (a - b).powi(2)).sum();
+                let (coverage, width_kn) = match &bands {
+                    Some(b) => {
+                        let inside = y
+                            .iter()
+                            .zip(&b.bounds)
+                            .filter(|(v, bd)| bd[k].0 <= **v && **v <= bd[k].1)
+                            .count();
+                        let width = b.bounds.iter().map(|bd| bd[k].1 - bd[k].0).sum::<f64>()
+                            / b.bounds.len().max(1) as f64;
+                        (
+                            Some(inside as f64 / y.len().max(1) as f64),
+                            Some(width / 1000.0),
+                        )
+                    }
+                    None => (None, None),
+                };
                 TargetCheck {
+                    coverage,
+                    width_kn,
                     target: t.clone(),
                     r2: 1.0 - sse / sst,
                     rmse_kn: (sse / y.len() as f64).sqrt() / 1000.0,
