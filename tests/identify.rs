@@ -28,9 +28,9 @@ fn synthetic(rows: usize) -> DataSet {
     DataSet::in_memory(&PathBuf::from("synthetic"), names, vec![run])
 }
 
-fn model(label_at: LabelAt, test: &str) -> (DataSet, Model) {
-    let ds = synthetic(600);
-    let spec = DataSpec {
+/// The synthetic data set's windows: channels a and b, 6 steps, the label at `label_at`.
+fn spec_of(label_at: LabelAt) -> DataSpec {
+    DataSpec {
         channels: vec!["a".into(), "b".into()],
         targets: vec!["w1l_force_y".into()],
         window: 6,
@@ -39,7 +39,12 @@ fn model(label_at: LabelAt, test: &str) -> (DataSet, Model) {
         split: Split::default(),
         noise: NoiseProtocol::Clean,
         noise_model: None,
-    };
+    }
+}
+
+fn model(label_at: LabelAt, test: &str) -> (DataSet, Model) {
+    let ds = synthetic(600);
+    let spec = spec_of(label_at);
     let out = std::env::temp_dir().join(format!(
         "railforce-identify-{}-{test}-{label_at:?}",
         std::process::id()
@@ -137,16 +142,7 @@ fn ensemble_bands_are_ordered_finite_and_survive_a_round_trip() {
     use railforce::identify::identify_with_bands;
     use railforce::learn::uncertainty::train_ensemble;
     let ds = synthetic(600);
-    let spec = DataSpec {
-        channels: vec!["a".into(), "b".into()],
-        targets: vec!["w1l_force_y".into()],
-        window: 6,
-        label_at: LabelAt::Centre,
-        stride: 1,
-        split: Split::default(),
-        noise: NoiseProtocol::Clean,
-        noise_model: None,
-    };
+    let spec = spec_of(LabelAt::Centre);
     let out = std::env::temp_dir().join(format!("railforce-ensemble-{}", std::process::id()));
     let opts = TrainOptions {
         epochs: 3,
@@ -332,16 +328,7 @@ fn ood_flag_fires_on_a_planted_offset_and_stays_quiet_otherwise() {
     use railforce::identify::out_of_distribution;
     use railforce::learn::uncertainty::train_ensemble;
     let ds = synthetic(600);
-    let spec = DataSpec {
-        channels: vec!["a".into(), "b".into()],
-        targets: vec!["w1l_force_y".into()],
-        window: 6,
-        label_at: LabelAt::Centre,
-        stride: 1,
-        split: Split::default(),
-        noise: NoiseProtocol::Clean,
-        noise_model: None,
-    };
+    let spec = spec_of(LabelAt::Centre);
     let out = std::env::temp_dir().join(format!("railforce-ood-{}", std::process::id()));
     let opts = TrainOptions {
         epochs: 2,

@@ -286,7 +286,10 @@ fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
     // The calibrated interval's coverage and width on the fresh run, per target.
     for t in &checks[0].targets {
         let (c, w) = (t.coverage.unwrap(), t.width_kn.unwrap());
-        assert!((0.0..=1.0).contains(&c) && w > 0.0 && w.is_finite(), "{c} {w}");
+        assert!(
+            (0.0..=1.0).contains(&c) && w > 0.0 && w.is_finite(),
+            "{c} {w}"
+        );
     }
     // The report: labelled JSON, tidy traces, a page whose every link resolves.
     let report = dir.join("report");

@@ -284,6 +284,20 @@ fn outside(envelope: &[[f64; 2]], window: &[f32], c: usize) -> Vec<usize> {
         .collect()
 }
 
+/// The checked input as the model reads it: rows `[time × channel]`, z-scored with the
+/// model's own statistics.
+fn standardised(model: &Model, input: &CheckedInput) -> Vec<f32> {
+    let (n, c) = (input.time.len(), input.columns.len());
+    let z = &model.meta.input_stats;
+    let mut rows = vec![0.0f32; n * c];
+    for (k, col) in input.columns.iter().enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            rows[i * c + k] = z.apply(k, *v) as f32;
+        }
+    }
+    rows
+}
+
 /// Estimates whose inputs left what the model was trained on: per estimate, the input channels
 /// (model order) outside the training envelope.
 #[derive(Debug, Clone, PartialEq)]
@@ -349,13 +363,7 @@ pub fn out_of_distribution(model: &Model, input: &CheckedInput) -> Option<OutOfD
     let spec = &model.meta.data;
     let (w, c) = (spec.window, spec.channels.len());
     let n = input.time.len();
-    let z = &model.meta.input_stats;
-    let mut rows = vec![0.0f32; n * c];
-    for (k, col) in input.columns.iter().enumerate() {
-        for (i, v) in col.iter().enumerate() {
-            rows[i * c + k] = z.apply(k, *v) as f32;
-        }
-    }
+    let rows = standardised(model, input);
     let count = (n + 1).saturating_sub(w);
     Some(OutOfDistribution {
         channels: (0..count)
@@ -385,13 +393,7 @@ pub fn identify_with_bands(
     let spec = model.meta.data.clone();
     let (w, c) = (spec.window, spec.channels.len());
     let n = input.time.len();
-    let z = &model.meta.input_stats;
-    let mut rows = vec![0.0f32; n * c];
-    for (k, col) in input.columns.iter().enumerate() {
-        for (i, v) in col.iter().enumerate() {
-            rows[i * c + k] = z.apply(k, *v) as f32;
-        }
-    }
+    let rows = standardised(model, input);
     let count = n + 1 - w;
     let mut x = Vec::with_capacity(count.min(4096) * w * c);
     let mut out = Vec::with_capacity(count * spec.targets.len());
