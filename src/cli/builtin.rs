@@ -144,6 +144,10 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../tracks/paper34.plan.toml"),
     ),
     (
+        "tracks/paper34_varied.plan.toml",
+        include_str!("../../tracks/paper34_varied.plan.toml"),
+    ),
+    (
         "tracks/tangent.toml",
         include_str!("../../tracks/tangent.toml"),
     ),
