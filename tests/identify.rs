@@ -152,7 +152,7 @@ fn ensemble_bands_are_ordered_finite_and_survive_a_round_trip() {
     let mut m = train_ensemble(&ds, &spec, ModelKind::Gru, &opts, 3, &out, &mut |_, _| {}).unwrap();
     assert_eq!((m.meta.members, m.members.len()), (3, 2));
     let cal = m.meta.calibration.clone().expect("calibrated");
-    assert_eq!(cal.score, "normalised");
+    assert_eq!(cal.score, railforce::learn::uncertainty::Score::Normalised);
     let input = check(&table(&ds), &m, false).unwrap();
     let (id, bands) = identify_with_bands(&mut m, &input, Some(0.9));
     let bands = bands.expect("bands");

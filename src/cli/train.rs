@@ -320,7 +320,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
     if let Some(c) = &model.meta.calibration {
         println!(
             "calibrated ({} score) on the {}; the 90 % half-width where the members agree as usual: {}",
-            c.score,
+            c.score.name(),
             c.part,
             spec.targets
                 .iter()

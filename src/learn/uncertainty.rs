@@ -23,11 +23,31 @@ const LEVELS: usize = 1000;
 /// Windows predicted per batch while calibrating.
 const BATCH: usize = 8192;
 
+/// The conformity score of a window.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Score {
+    /// `|y − ŷ|`: one model.
+    Absolute,
+    /// `|y − ŷ| / (σ + β)`: an ensemble, σ its members' spread.
+    Normalised,
+}
+
+impl Score {
+    /// `absolute` or `normalised`, as `model.json` writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Score::Absolute => "absolute",
+            Score::Normalised => "normalised",
+        }
+    }
+}
+
 /// A model's conformal calibration (in `model.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Calibration {
-    /// `absolute` (`|y − ŷ|`) or `normalised` (`|y − ŷ| / (σ + β)`).
-    pub score: String,
+    /// The conformity score.
+    pub score: Score,
     /// Per target, β of the normalised score (standardised units; 0 for `absolute`).
     pub beta: Vec<f64>,
     /// Per target, the conformal quantile of the score at each level `i/1000`.
@@ -93,11 +113,10 @@ impl Calibration {
         }
         Ok(Calibration {
             score: if spread.is_some() {
-                "normalised"
+                Score::Normalised
             } else {
-                "absolute"
-            }
-            .into(),
+                Score::Absolute
+            },
             beta,
             quantiles,
             windows: n,
@@ -111,7 +130,7 @@ impl Calibration {
     pub fn half_width(&self, k: usize, coverage: f64, spread: f64) -> f64 {
         let i = ((coverage.clamp(0.0, 1.0) * LEVELS as f64) - 1e-9).ceil() as usize;
         let q = self.quantiles[k][i.min(LEVELS)];
-        if self.score == "normalised" {
+        if self.score == Score::Normalised {
             q * (spread + self.beta[k])
         } else {
             q
@@ -279,7 +298,7 @@ mod tests {
                 assert!(
                     (inside - coverage).abs() < 0.02,
                     "{} at {coverage}: {inside}",
-                    cal.score
+                    cal.score.name()
                 );
             }
             if normalised {
