@@ -251,12 +251,7 @@ impl Manifest {
 
 /// FNV-1a 64 of bytes, hex.
 pub fn fnv1a(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    format!("{h:016x}")
+    format!("{:016x}", crate::io::fnv1a64(bytes))
 }
 
 /// Identity of a data set's contents: FNV-1a 64 over every run file's name and the hash of its

@@ -3,6 +3,7 @@
 
 #[cfg(feature = "burn")]
 pub mod burn;
+mod calibration;
 pub mod classical;
 pub mod evaluate;
 pub mod export;

@@ -111,7 +111,7 @@ pub struct ModelMeta {
     /// Conformal calibration on the validation part (`learn::uncertainty`); absent in models
     /// trained before 2026-12-02.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub calibration: Option<super::uncertainty::Calibration>,
+    pub calibration: Option<super::calibration::Calibration>,
 }
 
 fn one() -> usize {

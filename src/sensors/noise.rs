@@ -98,12 +98,7 @@ impl NoiseModel {
 
 /// Stream number of a channel: FNV-1a 64 of its (clean) name.
 pub fn channel_stream(channel: &str) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in super::clean_name(channel).as_bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h
+    crate::io::fnv1a64(super::clean_name(channel).as_bytes())
 }
 
 /// The random stream `stream` of seed `seed`: every noise draw of railforce goes through it.

@@ -300,12 +300,7 @@ impl Variation {
 
 /// FNV-1a 64 of `condition|seed|key`: the seed of one key's stream.
 fn stream(condition: &str, seed: u64, key: &str) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in format!("vary|{condition}|{seed}|{key}").as_bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h
+    crate::io::fnv1a64(format!("vary|{condition}|{seed}|{key}").as_bytes())
 }
 
 /// The draws of a run as the manifest records them: `{key: value}`, a factor as
