@@ -54,6 +54,7 @@ fn every_experiment_runs_end_to_end() {
             patience: 2,
             ..TrainOptions::default()
         },
+        fleet: Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("tracks/paper34_varied.plan.toml")),
         ..ExperimentOptions::full(tiny_plan(&dir), dir.join("out"))
     };
     let index = run(&[Which::All], &opts, &|_| {}).unwrap();
@@ -142,11 +143,40 @@ fn every_experiment_runs_end_to_end() {
     let sensors = std::fs::read_to_string(out.join("sensors/sensors.csv")).unwrap();
     assert!(sensors.contains("selected on-board") && sensors.contains("paper's 21"));
     assert!(header("sensors/selection_fq.csv").starts_with("channel,mi_nats"));
+    // Mismatch: 2 input sets × (nominal, fleet-trained) × (nominal, fleet, 4 extremes), each
+    // with its coverage and out-of-distribution share (every experiment model is calibrated).
+    let mismatch = std::fs::read_to_string(out.join("mismatch/mismatch.csv")).unwrap();
+    assert!(
+        header("mismatch/mismatch.csv").starts_with(
+            "inputs,trained_on,tested_on,windows,fl_r2,fl_rmse_kn,fq_r2,fq_rmse_kn,fl_covered,fq_covered"
+        ),
+        "{mismatch}"
+    );
+    assert_eq!(mismatch.lines().count(), 1 + 2 * 2 * 6, "{mismatch}");
+    for case in ["half_payload", "wet_rail", "high_conicity", "class4", "fleet"] {
+        assert!(mismatch.contains(case), "{case} missing: {mismatch}");
+    }
+    for line in mismatch.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        // fl_covered, fq_covered, fl/fq width, flagged: every model is calibrated.
+        assert!(f[8..13].iter().all(|v| !v.is_empty()), "{line}");
+    }
+    // The fleet's test runs drew their own wagons: the manifest records the draws.
+    let manifest = std::fs::read_to_string(out.join("mismatch/data/fleet/manifest.json")).unwrap();
+    assert!(manifest.contains("vehicle.contact.friction"));
+    let half = std::fs::read_to_string(out.join("mismatch/data/half_payload/manifest.json")).unwrap();
+    let half: serde_json::Value = serde_json::from_str(&half).unwrap();
+    let runs = half["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 3, "the test seed of three conditions");
+    for r in runs {
+        assert_eq!(r["seed"], 3);
+        assert_eq!(r["draws"]["vehicle.body.carbody.mass"]["scale"], 0.565);
+    }
     assert!(html.contains("label at the centre step"));
     assert!(html.contains("windows of 12 steps"));
     let data = meta["data_fnv1a"].clone();
 
-    // One part run again on its own into the same folder: the report still shows all five,
+    // One part run again on its own into the same folder: the report still shows all six,
     // and the data identity is unchanged (nothing was regenerated).
     let again = ExperimentOptions {
         robustness_models: vec![ModelKind::Tree],
@@ -160,6 +190,7 @@ fn every_experiment_runs_end_to_end() {
         "robustness",
         "protocols",
         "sensors",
+        "mismatch",
     ] {
         assert!(
             html.contains(&format!("id=\"{part}\"")),

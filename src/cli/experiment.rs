@@ -23,9 +23,13 @@ pub enum WhichArg {
     /// Filter–Wrapper over the on-board candidates for FL and FQ; the CNN-BiLSTM on the
     /// selected set against the paper's 21 at 6 and 1 dB.
     Sensors,
+    /// Wagons the models did not learn: the nominal CNN-BiLSTM (paper's 21 and the on-board
+    /// selection) against the same trained on a fleet (--fleet), on the fleet's held-out
+    /// wagons and four named extremes (half payload, wet rail, highest conicity, class 4).
+    Mismatch,
     /// The paper's three: comparison, generalization, robustness.
     Paper,
-    /// All five.
+    /// All six.
     All,
 }
 
@@ -37,6 +41,10 @@ pub struct ExperimentArgs {
     /// Plan of conditions (simulated once, clean; noise is added per SNR).
     #[arg(long, default_value = "tracks/paper34.plan.toml")]
     plan: PathBuf,
+    /// The fleet of the mismatch experiment: a plan whose conditions, by name, give each of
+    /// --plan's conditions its [vary] (wagons and tracks drawn per run).
+    #[arg(long, default_value = "tracks/paper34_varied.plan.toml")]
+    fleet: PathBuf,
     /// Output folder: data/, one folder per experiment, index.html, meta.json.
     #[arg(long, default_value = "experiments")]
     out: PathBuf,
@@ -113,11 +121,15 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
             WhichArg::Robustness => Which::Robustness,
             WhichArg::Protocols => Which::Protocols,
             WhichArg::Sensors => Which::Sensors,
+            WhichArg::Mismatch => Which::Mismatch,
             WhichArg::Paper => Which::Paper,
             WhichArg::All => Which::All,
         })
         .collect();
     let mut opts = ExperimentOptions::full(super::builtin::resolve(&args.plan)?, args.out);
+    if which.iter().any(|w| w.parts().contains(&Which::Mismatch)) {
+        opts.fleet = Some(super::builtin::resolve(&args.fleet)?);
+    }
     opts.condition = args.condition;
     opts.snr_db = args.snr_db;
     opts.jobs = args.jobs;

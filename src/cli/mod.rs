@@ -134,12 +134,13 @@ enum Command {
     )]
     Identify(identify::IdentifyArgs),
     /// Rerun the paper's experiments: model comparison, generalisation over conditions
-    /// (with leave-one-condition-out) and robustness to noise, and two of ours: the protocols
-    /// side by side and on-board sensor selection. Defaults: split by seed (independent test
+    /// (with leave-one-condition-out) and robustness to noise, and three of ours: the protocols
+    /// side by side, on-board sensor selection, and wagons the models did not learn
+    /// (mismatch: nominal against fleet-trained). Defaults: split by seed (independent test
     /// runs), 6 dB with σ from each channel's std, centre label. Writes tables (Markdown,
     /// CSV), SVG figures and index.html with the paper's numbers beside ours. The full
-    /// protocol on the paper's 34 conditions (`experiment all --plan paper34`) takes about an
-    /// hour on two cores; assets/docs/results.md lists what each part measured.
+    /// protocol on the paper's 34 conditions (`experiment all --plan paper34`) takes about
+    /// 80 minutes on two cores; assets/docs/results.md lists what each part measured.
     #[command(
         after_help = "Examples:\n  railforce experiment comparison --plan demo --out experiments --epochs 2 --windows-per-epoch 2000"
     )]

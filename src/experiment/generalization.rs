@@ -72,6 +72,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let mut fitted = ctx.fit_all(&jobs)?.into_iter();
     let (mut model, secs) = fitted.next().expect("the all-condition model");
     let ev = evaluate(&mut model, &dsn, EvalPart::Test)?;
+    ctx.trained
+        .push((super::PAPER21, dir.join("models/all_conditions")));
     let mut t = Table::new(&[
         "condition",
         "n",
@@ -83,8 +85,26 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         "Var(FQ_test)",
         "paper FQ MSE",
         "paper FQ R²",
+        "FL covered",
+        "FQ covered",
+        "FL width kN",
+        "FQ width kN",
     ]);
     let per = ev.per_condition(&model.meta.target_stats);
+    // The 90 % interval's coverage and mean width per condition (split conformal on the
+    // validation runs), pooled last.
+    let coverage = ev.coverage().unwrap_or_default();
+    let covered = |c: &str| -> Vec<String> {
+        match coverage.iter().find(|r| r.condition == c) {
+            Some(r) => vec![
+                format!("{:.1} %", 100.0 * r.targets[0].0),
+                format!("{:.1} %", 100.0 * r.targets[1].0),
+                format!("{:.2}", r.targets[0].1),
+                format!("{:.2}", r.targets[1].1),
+            ],
+            None => vec![MISSING.into(); 4],
+        }
+    };
     let mut bars = [Vec::new(), Vec::new(), Vec::new()];
     let mut in_dist = std::collections::HashMap::new();
     for c in &conditions {
@@ -93,7 +113,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         };
         let p = paper::generalization(c);
         let opt = |v: Option<f64>| v.map(f4).unwrap_or(MISSING.into());
-        t.push(vec![
+        let mut row = vec![
             c.clone(),
             m[0].n.to_string(),
             f4(m[0].mse),
@@ -104,7 +124,9 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             f4(m[1].var_y),
             opt(p.map(|p| p.0)),
             opt(p.map(|p| p.1)),
-        ]);
+        ];
+        row.extend(covered(c));
+        t.push(row);
         bars[0].push(Some(m[0].r2));
         bars[1].push(Some(m[1].r2));
         bars[2].push(p.map(|p| p.1));
@@ -124,7 +146,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let (assess_table, assess_chart) = super::assessment::report(&per_assess);
     let all = &ev.metrics;
     ctx.pooled = Some(all.clone());
-    t.push(vec![
+    let mut row = vec![
         "all (pooled)".into(),
         all[0].n.to_string(),
         f4(all[0].mse),
@@ -135,7 +157,9 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         f4(all[1].var_y),
         MISSING.into(),
         MISSING.into(),
-    ]);
+    ];
+    row.extend(covered("all (pooled)"));
+    t.push(row);
     let mut lt = Table::new(&[
         "held-out condition",
         "validation condition",
@@ -190,6 +214,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 opts.snr_db
             ),
             ctx.protocol(&ctx.split, Some(opts.snr_db)),
+            "Covered: the share of each condition's true forces inside the model's 90 % interval (split conformal on the validation runs, learning.md §3.1), with its mean width.".into(),
             "Leave-one-condition-out (not in the paper): the model is trained without the held-out condition (all its seeds) and without the validation condition used for early stopping, and tested on every run of the held-out condition — transfer to an unseen condition. \"Seen\" is the all-condition model on the same condition's test runs.".into(),
         ],
         tables: vec![

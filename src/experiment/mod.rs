@@ -1,7 +1,7 @@
 //! The paper's experiments on railforce data (assets/docs/learning.md §4), and two of ours: model
 //! comparison, generalisation over conditions (with leave-one-condition-out, which the paper
-//! never ran), robustness to noise under both noise protocols, the protocols side by side, and
-//! on-board sensor selection. Defaults: the plan's seeds split by seed (independent test runs),
+//! never ran), robustness to noise under both noise protocols, the protocols side by side,
+//! on-board sensor selection, and wagons the models did not learn (mismatch). Defaults: the plan's seeds split by seed (independent test runs),
 //! 6 dB with σ from each channel's standard deviation, window 20 with the centre label, fresh
 //! training noise. Each writes Markdown and CSV tables, SVG figures and its part of
 //! `index.html`, with seeds, data identity, protocol, noise definition, label position,
@@ -10,6 +10,7 @@
 mod assessment;
 mod comparison;
 mod generalization;
+mod mismatch;
 mod paper;
 mod protocols;
 mod robustness;
@@ -22,6 +23,7 @@ use crate::features::{LabelAt, NoiseProtocol, Split};
 use crate::learn::metrics::{Metrics, metrics};
 use crate::learn::model::{Model, ModelKind};
 use crate::learn::train::{EpochLog, Progress, TrainOptions, train};
+use crate::learn::uncertainty::calibrate;
 use crate::learn::windows::{DataRequest, DataSpec, prepare};
 use crate::plan::Plan;
 use crate::report::write_index;
@@ -43,9 +45,11 @@ pub enum Which {
     Protocols,
     /// Filter–Wrapper over the on-board candidates against the paper's 21.
     Sensors,
+    /// Nominal against fleet-trained models on wagons they did not learn.
+    Mismatch,
     /// The paper's three (comparison, generalisation, robustness): the demo.
     Paper,
-    /// All five.
+    /// All six.
     All,
 }
 
@@ -54,19 +58,27 @@ impl Which {
     pub fn parts(self) -> Vec<Which> {
         use Which::*;
         match self {
-            All => vec![Comparison, Generalization, Robustness, Protocols, Sensors],
+            All => vec![
+                Comparison,
+                Generalization,
+                Robustness,
+                Protocols,
+                Sensors,
+                Mismatch,
+            ],
             Paper => vec![Comparison, Generalization, Robustness],
             w => vec![w],
         }
     }
 
     /// Every experiment's folder, in report order.
-    pub const FOLDERS: [&'static str; 5] = [
+    pub const FOLDERS: [&'static str; 6] = [
         "comparison",
         "generalization",
         "robustness",
         "protocols",
         "sensors",
+        "mismatch",
     ];
 
     fn folder(self) -> &'static str {
@@ -76,6 +88,7 @@ impl Which {
             Which::Robustness => "robustness",
             Which::Protocols => "protocols",
             Which::Sensors => "sensors",
+            Which::Mismatch => "mismatch",
             _ => "all",
         }
     }
@@ -120,6 +133,9 @@ pub struct ExperimentOptions {
     /// The split (default: by seed when the plan has at least three seeds, see
     /// [`Split::standard`]).
     pub split: Option<Split>,
+    /// The fleet of the mismatch experiment: a plan whose conditions (by name) give each of
+    /// the plan's conditions its `[vary]` (the built-in `paper34_varied` for paper34).
+    pub fleet: Option<PathBuf>,
 }
 
 impl ExperimentOptions {
@@ -154,6 +170,7 @@ impl ExperimentOptions {
             window: 20,
             fresh_noise: true,
             split: None,
+            fleet: None,
         }
     }
 
@@ -183,7 +200,17 @@ struct Ctx<'a> {
     /// experiments' SNR under the default split, once trained (generalisation): the same model
     /// the protocols and sensors experiments would train again, so they reuse it.
     pooled: Option<Vec<Metrics>>,
+    /// Models trained (and calibrated) on the nominal data at the experiments' SNR that a later
+    /// part reuses: [`PAPER21`] (generalisation) and [`SELECTED`] (sensors), by folder.
+    trained: Vec<(&'static str, PathBuf)>,
+    /// The on-board selection (union for FL and FQ) once the sensors experiment made it.
+    selected: Option<Vec<String>>,
 }
+
+/// [`Ctx::trained`]: the all-condition CNN-BiLSTM on the paper's 21.
+const PAPER21: &str = "paper21";
+/// [`Ctx::trained`]: the all-condition CNN-BiLSTM on the on-board selection.
+const SELECTED: &str = "selected";
 
 impl Ctx<'_> {
     /// Data spec of a model over `channels` predicting `targets` on `ds` (the one
@@ -247,7 +274,7 @@ impl Ctx<'_> {
             windows_per_epoch: windows_per_epoch.or(self.opts.train.windows_per_epoch),
             ..self.opts.train.clone()
         };
-        let model = train(ds, spec, kind, &opts, dir, &mut |p| {
+        let mut model = train(ds, spec, kind, &opts, dir, &mut |p| {
             if let Progress::Epoch(e) = p
                 && (e.epoch % 10 == 0 || e.epoch == 1)
             {
@@ -257,6 +284,15 @@ impl Ctx<'_> {
                 ));
             }
         })?;
+        // Split conformal on the validation part, and the training envelope: every model of
+        // the experiments reports its intervals' coverage and flags what it never saw.
+        match calibrate(&mut model, ds) {
+            Ok(cal) => {
+                model.meta.calibration = Some(cal);
+                model.save(dir)?;
+            }
+            Err(e) => (self.log)(format!("  {name}: not calibrated: {e}")),
+        }
         let secs = t0.elapsed().as_secs_f64();
         (self.log)(format!("  {name}: done in {secs:.1} s"));
         Ok((model, secs))
@@ -324,6 +360,20 @@ struct FitJob<'d> {
     kind: ModelKind,
     dir: PathBuf,
     windows: Option<usize>,
+}
+
+/// Simulates `plan` (clean, NPZ, 3 s settling) into `dir`, resuming what is there.
+fn simulate(plan: &Plan, dir: &Path, jobs: usize) -> Result<()> {
+    let gopts = GenerateOptions {
+        out: dir.to_path_buf(),
+        format: Format::Npz,
+        jobs: jobs.max(1),
+        shard: None,
+        noise: None,
+        settle: 3.0,
+    };
+    generate(plan, &gopts, &|_| {})?;
+    Ok(())
 }
 
 /// The columns the experiments keep (time, labels, the candidates): the rest is dropped.
@@ -468,16 +518,8 @@ pub fn run(
         plan.name,
         data_dir.display()
     ));
-    let gopts = GenerateOptions {
-        out: data_dir.clone(),
-        format: Format::Npz,
-        jobs: opts.jobs.max(1),
-        shard: None,
-        noise: None,
-        settle: 3.0,
-    };
-    generate(&plan, &gopts, &|_| {})?;
-    let candidates = if parts.contains(&Which::Sensors) {
+    simulate(&plan, &data_dir, opts.jobs)?;
+    let candidates = if parts.contains(&Which::Sensors) || parts.contains(&Which::Mismatch) {
         Candidates::Onboard
     } else {
         Candidates::Paper21
@@ -513,6 +555,8 @@ pub fn run(
         split: split.clone(),
         conditions,
         pooled: None,
+        trained: Vec::new(),
+        selected: None,
     };
     let mut timings = serde_json::Map::new();
     let common = json!({
@@ -540,7 +584,8 @@ pub fn run(
             Which::Generalization => generalization::run(&mut ctx)?,
             Which::Robustness => robustness::run(&mut ctx)?,
             Which::Protocols => protocols::run(&mut ctx)?,
-            _ => sensors::run(&mut ctx)?,
+            Which::Sensors => sensors::run(&mut ctx)?,
+            _ => mismatch::run(&mut ctx)?,
         };
         let secs = ts.elapsed().as_secs_f64();
         let folder = part.folder();

@@ -20,59 +20,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         .distinct_channels(&Candidates::Onboard.among(&ctx.ds.names, &ctx.ds.labels));
     let dir = opts.out.join("sensors");
     let dsn = ctx.noisy(&ctx.ds, opts.snr_db, &onboard)?;
-    let mut chosen: Vec<String> = Vec::new();
-    let mut sel_tables = Vec::new();
-    for target in ["FL", "FQ"] {
-        (ctx.log)(format!(
-            "selecting sensors for {target} among {} on-board candidates …",
-            onboard.len()
-        ));
-        let so = SelectOptions {
-            target: target.into(),
-            noisy: true,
-            window: opts.window,
-            label_at: opts.label_at,
-            candidates: Candidates::Onboard,
-            ..SelectOptions::default()
-        };
-        let sel = select(&dsn, &ctx.split, &so)?;
-        let mut t = Table::new(&["channel", "MI nats", "wrapper gain", "kept"]);
-        for r in &sel.table {
-            t.push(vec![
-                clean_name(&r.channel).to_string(),
-                f4(r.mi),
-                r.wrapper_gain
-                    .map(|g| format!("{g:+.4}"))
-                    .unwrap_or_else(|| "filtered".into()),
-                if r.kept { "yes".into() } else { String::new() },
-            ]);
-        }
-        (ctx.log)(format!(
-            "  {target}: kept {} channels: {}",
-            sel.channels.len(),
-            sel.channels
-                .iter()
-                .map(|c| clean_name(c))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
-        for c in &sel.channels {
-            let c = clean_name(c).to_string();
-            if !chosen.contains(&c) {
-                chosen.push(c);
-            }
-        }
-        sel_tables.push((
-            format!(
-                "Filter–Wrapper for {target} over {} on-board candidates (MI on at most {} training rows, ridge on at most {} training windows)",
-                onboard.len(),
-                so.mi_samples,
-                so.max_windows
-            ),
-            t,
-            format!("selection_{}", target.to_lowercase()),
-        ));
-    }
+    let (chosen, sel_tables) = choose(ctx, &dsn, onboard.len())?;
+    ctx.selected = Some(chosen.clone());
     let mut t = Table::new(&[
         "inputs",
         "channels",
@@ -151,6 +100,11 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             format!("{:.2}", e[1].rmse_kn),
         ]);
     }
+    // The selected set's model at the experiments' SNR serves the mismatch experiment too.
+    let selected_dir = dir.join(format!("models/selected_{}dB", opts.snr_db));
+    if jobs.iter().any(|j| j.dir == selected_dir) {
+        ctx.trained.push((super::SELECTED, selected_dir));
+    }
     let mut tables = vec![(
         "CNN-BiLSTM (FL and FQ as two outputs), pooled test metrics".into(),
         t,
@@ -171,4 +125,68 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         tables,
         figures: Vec::new(),
     })
+}
+
+/// The Filter–Wrapper for FL and for FQ over the on-board candidates of `dsn` (noisy at the
+/// experiments' SNR): the union of the two selections (clean names) and each selection's table.
+pub(super) fn choose(
+    ctx: &Ctx,
+    dsn: &crate::dataset::DataSet,
+    candidates: usize,
+) -> Result<(Vec<String>, Vec<(String, Table, String)>)> {
+    let opts = ctx.opts;
+    let mut chosen: Vec<String> = Vec::new();
+    let mut sel_tables = Vec::new();
+    for target in ["FL", "FQ"] {
+        (ctx.log)(format!(
+            "selecting sensors for {target} among {} on-board candidates …",
+            candidates
+        ));
+        let so = SelectOptions {
+            target: target.into(),
+            noisy: true,
+            window: opts.window,
+            label_at: opts.label_at,
+            candidates: Candidates::Onboard,
+            ..SelectOptions::default()
+        };
+        let sel = select(dsn, &ctx.split, &so)?;
+        let mut t = Table::new(&["channel", "MI nats", "wrapper gain", "kept"]);
+        for r in &sel.table {
+            t.push(vec![
+                clean_name(&r.channel).to_string(),
+                f4(r.mi),
+                r.wrapper_gain
+                    .map(|g| format!("{g:+.4}"))
+                    .unwrap_or_else(|| "filtered".into()),
+                if r.kept { "yes".into() } else { String::new() },
+            ]);
+        }
+        (ctx.log)(format!(
+            "  {target}: kept {} channels: {}",
+            sel.channels.len(),
+            sel.channels
+                .iter()
+                .map(|c| clean_name(c))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        for c in &sel.channels {
+            let c = clean_name(c).to_string();
+            if !chosen.contains(&c) {
+                chosen.push(c);
+            }
+        }
+        sel_tables.push((
+            format!(
+                "Filter–Wrapper for {target} over {} on-board candidates (MI on at most {} training rows, ridge on at most {} training windows)",
+                candidates,
+                so.mi_samples,
+                so.max_windows
+            ),
+            t,
+            format!("selection_{}", target.to_lowercase()),
+        ));
+    }
+    Ok((chosen, sel_tables))
 }

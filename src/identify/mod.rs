@@ -264,25 +264,9 @@ pub fn identify(model: &mut Model, input: &CheckedInput) -> Identified {
     identify_with_bands(model, input, None).0
 }
 
-/// How far beyond the training envelope (as a fraction of its width, on either side) an input
-/// may go before its estimate is flagged out of distribution.
-pub const OOD_MARGIN: f64 = 0.25;
-
-/// The input channels (indices in model order) of a standardised window `[steps × c]` that
-/// leave the calibration's training envelope by more than [`OOD_MARGIN`] anywhere in it.
-fn outside(envelope: &[[f64; 2]], window: &[f32], c: usize) -> Vec<usize> {
-    (0..c.min(envelope.len()))
-        .filter(|&k| {
-            let [lo, hi] = envelope[k];
-            let m = OOD_MARGIN * (hi - lo);
-            window
-                .iter()
-                .skip(k)
-                .step_by(c)
-                .any(|&v| (v as f64) < lo - m || (v as f64) > hi + m)
-        })
-        .collect()
-}
+/// How far beyond the training envelope an input may go before its estimate is flagged
+/// (the calibration's rule: [`crate::learn::uncertainty::OOD_MARGIN`]).
+pub use crate::learn::uncertainty::OOD_MARGIN;
 
 /// The checked input as the model reads it: rows `[time × channel]`, z-scored with the
 /// model's own statistics.
@@ -356,8 +340,8 @@ impl OutOfDistribution {
 /// The out-of-distribution check of a whole recording against the model's training envelope
 /// (`None` for a model without one: trained before 2026-12-02).
 pub fn out_of_distribution(model: &Model, input: &CheckedInput) -> Option<OutOfDistribution> {
-    let env = &model.meta.calibration.as_ref()?.envelope;
-    if env.is_empty() {
+    let cal = model.meta.calibration.as_ref()?;
+    if cal.envelope.is_empty() {
         return None;
     }
     let spec = &model.meta.data;
@@ -367,7 +351,7 @@ pub fn out_of_distribution(model: &Model, input: &CheckedInput) -> Option<OutOfD
     let count = (n + 1).saturating_sub(w);
     Some(OutOfDistribution {
         channels: (0..count)
-            .map(|s| outside(env, &rows[s * c..(s + w) * c], c))
+            .map(|s| cal.outside(&rows[s * c..(s + w) * c], c))
             .collect(),
     })
 }
@@ -562,7 +546,7 @@ impl<'a> Streamer<'a> {
             .calibration
             .as_ref()
             .filter(|cal| !cal.envelope.is_empty())
-            .map(|cal| outside(&cal.envelope, &self.x, c));
+            .map(|cal| cal.outside(&self.x, c));
         let times: Vec<f64> = self.times.iter().copied().collect();
         let id = finish(self.model, &times, out, 1);
         Some(Estimate {

@@ -8,6 +8,10 @@ use serde::{Deserialize, Serialize};
 /// Quantile levels stored per target: `i / LEVELS` for `i = 0..=LEVELS`.
 const LEVELS: usize = 1000;
 
+/// How far beyond the training envelope (as a fraction of its width, on either side) an input
+/// may go before its window is flagged out of distribution.
+pub const OOD_MARGIN: f64 = 0.25;
+
 /// The conformity score of a window.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -108,6 +112,23 @@ impl Calibration {
             part,
             envelope: Vec::new(),
         })
+    }
+
+    /// The input channels (indices in model order) of a standardised window `[steps × c]` that
+    /// leave the training envelope by more than [`OOD_MARGIN`] of its width anywhere in it
+    /// (none where the calibration has no envelope).
+    pub fn outside(&self, window: &[f32], c: usize) -> Vec<usize> {
+        (0..c.min(self.envelope.len()))
+            .filter(|&k| {
+                let [lo, hi] = self.envelope[k];
+                let m = OOD_MARGIN * (hi - lo);
+                window
+                    .iter()
+                    .skip(k)
+                    .step_by(c)
+                    .any(|&v| (v as f64) < lo - m || (v as f64) > hi + m)
+            })
+            .collect()
     }
 
     /// Half-width of target `k`'s interval at `coverage` (0–1) where the ensemble's spread is

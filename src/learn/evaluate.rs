@@ -36,6 +36,9 @@ pub struct Evaluation {
     /// Per row and target, the half-width (N) of the model's interval at [`EVAL_COVERAGE`]
     /// (`None`: the model is not calibrated).
     pub half_widths: Option<Vec<Vec<f64>>>,
+    /// Per row, whether an input left the training envelope (the rule `identify` flags by,
+    /// [`crate::learn::uncertainty::OOD_MARGIN`]); `None`: the model has no envelope.
+    pub outside: Option<Vec<bool>>,
 }
 
 /// The coverage at which `evaluate` scores the model's intervals.
@@ -81,6 +84,18 @@ pub fn evaluate(model: &mut Model, ds: &DataSet, part: EvalPart) -> Result<Evalu
             })
             .collect()
     });
+    let outside = model
+        .meta
+        .calibration
+        .as_ref()
+        .filter(|cal| !cal.envelope.is_empty())
+        .map(|cal| {
+            let c = prep.test.channels;
+            let len = x.len() / prep.test.len().max(1);
+            x.chunks(len.max(1))
+                .map(|w| !cal.outside(w, c).is_empty())
+                .collect()
+        });
     let m = metrics(&y, &p, &stats.1);
     let time = ds.channel("time_s").ok();
     let o = prep.test.outputs;
@@ -105,6 +120,7 @@ pub fn evaluate(model: &mut Model, ds: &DataSet, part: EvalPart) -> Result<Evalu
         windows_per_s,
         rows,
         half_widths,
+        outside,
     })
 }
 
@@ -257,6 +273,7 @@ mod tests {
         }
         let ev = Evaluation {
             half_widths: None,
+            outside: None,
             metrics: metrics(&y, &p, &stats),
             windows_per_s: 0.0,
             rows,

@@ -9,7 +9,7 @@
 //! coverage `c` is `ŷ ± q·(σ + β)` (or `ŷ ± q`) with `q` the `⌈(n+1)·c⌉`-th smallest of the `n`
 //! scores: marginal coverage of at least `c` on data exchangeable with the validation runs.
 
-pub use super::calibration::{Calibration, Score};
+pub use super::calibration::{Calibration, OOD_MARGIN, Score};
 use super::model::Model;
 use super::train::{Progress, TrainOptions, train};
 use super::windows::{DataSpec, prepare};

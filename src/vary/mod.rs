@@ -284,6 +284,30 @@ impl Vary {
 }
 
 impl Variation {
+    /// One line for reports: `key (and with-keys): uniform 0.8–1.2 × the file's value`.
+    pub fn describe(&self) -> String {
+        let show = |v: &toml::Value| match v {
+            toml::Value::Float(f) => format!("{f}"),
+            other => other.to_string(),
+        };
+        let draw = match &self.draw {
+            Draw::Uniform(lo, hi) => format!("uniform {lo}–{hi}"),
+            Draw::Normal(m, s) => format!("normal {m} ± {s} (cut at ±3σ)"),
+            Draw::OneOf(v) if v.len() == 1 => show(&v[0]),
+            Draw::OneOf(v) => format!(
+                "one of {}",
+                v.iter().map(show).collect::<Vec<_>>().join(" / ")
+            ),
+        };
+        let with = if self.with.is_empty() {
+            String::new()
+        } else {
+            format!(" (with {})", self.with.join(", "))
+        };
+        let scale = if self.scale { " × the file's value" } else { "" };
+        format!("{}{with}: {draw}{scale}", self.key)
+    }
+
     /// Puts `value` into `draws` under this variation's key and its `with` keys.
     pub fn insert(&self, draws: &mut Draws, value: toml::Value) {
         for k in std::iter::once(&self.key).chain(&self.with) {
