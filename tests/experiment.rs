@@ -153,7 +153,13 @@ fn every_experiment_runs_end_to_end() {
         "{mismatch}"
     );
     assert_eq!(mismatch.lines().count(), 1 + 2 * 2 * 6, "{mismatch}");
-    for case in ["half_payload", "wet_rail", "high_conicity", "class4", "fleet"] {
+    for case in [
+        "half_payload",
+        "wet_rail",
+        "high_conicity",
+        "class4",
+        "fleet",
+    ] {
         assert!(mismatch.contains(case), "{case} missing: {mismatch}");
     }
     for line in mismatch.lines().skip(1) {
@@ -164,7 +170,8 @@ fn every_experiment_runs_end_to_end() {
     // The fleet's test runs drew their own wagons: the manifest records the draws.
     let manifest = std::fs::read_to_string(out.join("mismatch/data/fleet/manifest.json")).unwrap();
     assert!(manifest.contains("vehicle.contact.friction"));
-    let half = std::fs::read_to_string(out.join("mismatch/data/half_payload/manifest.json")).unwrap();
+    let half =
+        std::fs::read_to_string(out.join("mismatch/data/half_payload/manifest.json")).unwrap();
     let half: serde_json::Value = serde_json::from_str(&half).unwrap();
     let runs = half["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 3, "the test seed of three conditions");

@@ -4,6 +4,7 @@
 mod assess;
 mod bench;
 mod builtin;
+mod calibrate;
 mod contact;
 mod experiment;
 mod export;
@@ -121,6 +122,13 @@ enum Command {
     /// per-condition metrics to CSV.
     #[command(after_help = "Examples:\n  railforce evaluate --model models/demo --data data/demo")]
     Evaluate(train::EvaluateArgs),
+    /// Calibrate a trained model's intervals again, on the validation runs of a data set,
+    /// without training: split conformal prediction (assets/docs/learning.md §3.1), by default
+    /// with intervals that follow each window's difficulty; writes model.json.
+    #[command(
+        after_help = "Examples:\n  railforce calibrate --model models/demo --data data/demo\n  railforce calibrate --model models/demo --data data/demo --uniform"
+    )]
+    Calibrate(calibrate::CalibrateArgs),
     /// Identify wheel–rail forces from a sensor recording with a trained model, with safety
     /// indices (|Y|/Q, wheel unloading ΔQ/Q̄, wheelset lateral force) and an exceedance report.
     ///
@@ -238,6 +246,7 @@ pub fn main() -> ExitCode {
         Command::Select(args) => select::run(args),
         Command::Train(args) => train::run(args),
         Command::Evaluate(args) => train::run_evaluate(args),
+        Command::Calibrate(args) => calibrate::run(args),
         Command::Identify(args) => identify::run(args),
         Command::Experiment(args) => experiment::run(args),
         Command::Demo(args) => experiment::demo(args),

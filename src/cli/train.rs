@@ -328,7 +328,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
                 .map(|(k, n)| format!(
                     "{} {:.2} kN",
                     short(n),
-                    c.half_width(k, 0.9, c.beta[k]) * model.meta.target_stats.std[k] * 1e-3
+                    c.half_width(k, 0.9, c.beta[k], 1.0) * model.meta.target_stats.std[k] * 1e-3
                 ))
                 .collect::<Vec<_>>()
                 .join(", ")

@@ -163,7 +163,11 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     }];
     let mut plans = vec![("fleet", fleet.clone(), EvalPart::Test)];
     for (name, _, table) in EXTREMES {
-        plans.push((name, extreme(&plan, name, table, &test_seeds)?, EvalPart::All));
+        plans.push((
+            name,
+            extreme(&plan, name, table, &test_seeds)?,
+            EvalPart::All,
+        ));
     }
     let ts = Instant::now();
     for (name, p, part) in plans {

@@ -402,7 +402,8 @@ pub fn identify_with_bands(
                 bounds: (0..count)
                     .map(|s| {
                         let sp = (!spread.is_empty()).then(|| &spread[s * o..(s + 1) * o]);
-                        bounds(model, &out[s * o..(s + 1) * o], sp, cov)
+                        let window = &rows[s * c..(s + w) * c];
+                        bounds(model, &out[s * o..(s + 1) * o], sp, window, cov)
                     })
                     .collect(),
             })
@@ -412,15 +413,23 @@ pub fn identify_with_bands(
     (finish(model, &input.time, out, count), bands)
 }
 
-/// The interval (N) around one estimate: its standardised prediction `mean` and the members'
-/// `spread` per target, at `coverage` (the model must be calibrated).
-fn bounds(model: &Model, mean: &[f32], spread: Option<&[f32]>, coverage: f64) -> Vec<(f64, f64)> {
+/// The interval (N) around one estimate: its standardised prediction `mean`, the members'
+/// `spread` per target and its standardised input `window`, at `coverage` (the model must be
+/// calibrated).
+fn bounds(
+    model: &Model,
+    mean: &[f32],
+    spread: Option<&[f32]>,
+    window: &[f32],
+    coverage: f64,
+) -> Vec<(f64, f64)> {
     let cal = model.meta.calibration.as_ref().expect("a calibrated model");
     let ts = &model.meta.target_stats;
+    let level = cal.difficulty_of(window, model.meta.data.channels.len(), mean);
     (0..mean.len())
         .map(|k| {
             let sp = spread.map_or(0.0, |s| s[k] as f64);
-            let h = cal.half_width(k, coverage, sp) * ts.std[k];
+            let h = cal.half_width(k, coverage, sp, level[k]) * ts.std[k];
             let v = mean[k] as f64 * ts.std[k] + ts.mean[k];
             (v - h, v + h)
         })
@@ -537,7 +546,7 @@ impl<'a> Streamer<'a> {
         let (out, spread) = self.model.predict_spread(&x, 1);
         self.x = x;
         let band = match (coverage, &self.model.meta.calibration) {
-            (Some(c), Some(_)) => Some(bounds(self.model, &out, spread.as_deref(), c)),
+            (Some(cov), Some(_)) => Some(bounds(self.model, &out, spread.as_deref(), &self.x, cov)),
             _ => None,
         };
         let outside_env = self

@@ -49,33 +49,130 @@ pub struct Calibration {
     /// training part: what the model has seen (`identify` flags inputs beyond it).
     #[serde(default)]
     pub envelope: Vec<[f64; 2]>,
+    /// Per target, the weights `w` of the window's difficulty `exp(w·f(x))` that also divides
+    /// the score (locally weighted split conformal, Lei et al. 2018 §5.2): `f(x)` is 1 and
+    /// `ln(0.1 + rms)` of each standardised input over the window ([`features`]), the weights
+    /// a ridge fit of `ln |score|` on alternate 1 s blocks of the validation runs (the other
+    /// blocks calibrate), centred so the median window's difficulty is 1. Empty: none (the
+    /// score is the same everywhere but for an ensemble's spread).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub difficulty: Vec<Vec<f64>>,
+    /// Per target, the difficulty at the edges between [`BINS`] equally filled bins of the
+    /// calibrating windows (Mondrian conformal, Vovk 2003: each bin its own quantiles, so
+    /// the coverage holds at every level even where the difficulty model is only roughly
+    /// right). Empty with `difficulty`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub edges: Vec<Vec<f64>>,
+    /// Per target and bin, the quantiles at each level `i/1000` of the score within the bin.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub binned: Vec<Vec<Vec<f64>>>,
+}
+
+/// Difficulty bins of the Mondrian calibration.
+const BINS: usize = 5;
+
+/// The conformal quantile of sorted `scores` at every level `i / LEVELS`: the
+/// `⌈(n+1)·c⌉`-th smallest.
+fn levels(scores: &[f64]) -> Vec<f64> {
+    let n = scores.len();
+    (0..=LEVELS)
+        .map(|i| {
+            let c = i as f64 / LEVELS as f64;
+            let rank = ((n + 1) as f64 * c).ceil() as usize;
+            scores[rank.clamp(1, n) - 1]
+        })
+        .collect()
+}
+
+/// Windows per block of the alternate-block split between fitting the difficulty and
+/// calibrating (1 s at 200 Hz for stride-1 windows).
+const BLOCK: usize = 200;
+
+/// The difficulty features of a standardised window `[steps × c]` and the model's standardised
+/// `prediction` for it: 1, then `ln(0.1 + rms)` of each channel over the window (the inputs'
+/// own level: faster, rougher or sharper running raises it; 0.1 keeps a silent channel
+/// finite), then each predicted target and its magnitude (a sharp curve's large lateral
+/// force). [`feature_count`] of them.
+pub fn features(window: &[f32], c: usize, prediction: &[f32]) -> Vec<f64> {
+    let steps = (window.len() / c.max(1)).max(1);
+    let mut f = vec![0.0; c + 1];
+    f[0] = 1.0;
+    for (i, v) in window.iter().enumerate() {
+        f[1 + i % c] += (*v as f64) * (*v as f64);
+    }
+    for v in &mut f[1..] {
+        *v = (0.1 + (*v / steps as f64).sqrt()).ln();
+    }
+    f.extend(prediction.iter().map(|&p| p as f64));
+    f.extend(prediction.iter().map(|&p| (p as f64).abs()));
+    f
+}
+
+/// How many [`features`] a window of `c` channels has for a model of `outputs` targets.
+pub fn feature_count(c: usize, outputs: usize) -> usize {
+    1 + c + 2 * outputs
+}
+
+/// Ridge least squares `(XᵀX + λ·n·I)⁻¹ Xᵀ t` (the bias unpenalised) of rows `x[n × d]`.
+fn ridge(x: &[f64], t: &[f64], d: usize) -> Option<Vec<f64>> {
+    let n = t.len();
+    let mut a = nalgebra::DMatrix::<f64>::zeros(d, d);
+    let mut b = nalgebra::DVector::<f64>::zeros(d);
+    for (i, ti) in t.iter().enumerate() {
+        let r = &x[i * d..(i + 1) * d];
+        for j in 0..d {
+            b[j] += r[j] * ti;
+            for l in 0..d {
+                a[(j, l)] += r[j] * r[l];
+            }
+        }
+    }
+    for j in 1..d {
+        a[(j, j)] += 1e-3 * n as f64;
+    }
+    let w = a.cholesky()?.solve(&b);
+    w.iter()
+        .all(|v| v.is_finite())
+        .then(|| w.iter().copied().collect())
 }
 
 impl Calibration {
-    /// Calibrates on standardised labels `y[n × outputs]`, predictions `mean` and (an
-    /// ensemble's) spread.
+    /// Calibrates on standardised labels `y[n × outputs]`, predictions `mean`, (an
+    /// ensemble's) spread and, where given, each window's difficulty [`features`]
+    /// (`n × d`, in window order: windows of whole runs at stride 1, so alternate
+    /// [`BLOCK`]s fit the difficulty and calibrate).
     pub fn fit(
         y: &[f32],
         mean: &[f32],
         spread: Option<&[f32]>,
         outputs: usize,
+        features: Option<(&[f64], usize)>,
         part: String,
     ) -> Result<Self> {
         let n = y.len() / outputs.max(1);
-        if n == 0 || mean.len() != y.len() || spread.is_some_and(|s| s.len() != y.len()) {
+        if n == 0
+            || mean.len() != y.len()
+            || spread.is_some_and(|s| s.len() != y.len())
+            || features.is_some_and(|(f, d)| f.len() != n * d)
+            || features.is_some() && n < 4 * BLOCK
+        {
             return Err(Error::Domain(format!(
                 "calibration needs windows with one prediction each ({part})"
             )));
         }
         let mut beta = vec![0.0; outputs];
         let mut quantiles = Vec::with_capacity(outputs);
+        let mut difficulty = Vec::new();
+        let (mut edges, mut binned) = (Vec::new(), Vec::new());
+        // With a difficulty, even blocks fit it and odd blocks calibrate.
+        let calibrates = |i: usize| features.is_none() || (i / BLOCK) % 2 == 1;
         for k in 0..outputs {
             if let Some(s) = spread {
                 let mut sk: Vec<f64> = (0..n).map(|i| s[i * outputs + k] as f64).collect();
                 sk.sort_by(f64::total_cmp);
                 beta[k] = sk[n / 2].max(1e-6);
             }
-            let mut scores: Vec<f64> = (0..n)
+            let base: Vec<f64> = (0..n)
                 .map(|i| {
                     let r = (y[i * outputs + k] - mean[i * outputs + k]).abs() as f64;
                     match spread {
@@ -84,21 +181,71 @@ impl Calibration {
                     }
                 })
                 .collect();
-            if scores.iter().any(|v| !v.is_finite()) {
+            if base.iter().any(|v| !v.is_finite()) {
                 return Err(Error::Domain(format!(
                     "calibration on {part}: a prediction is not finite"
                 )));
             }
+            let mut level = vec![1.0; n];
+            if let Some((f, d)) = features {
+                let fit: Vec<usize> = (0..n).filter(|&i| !calibrates(i)).collect();
+                let mut typical: Vec<f64> = fit.iter().map(|&i| base[i]).collect();
+                typical.sort_by(f64::total_cmp);
+                let eps = 0.05 * typical[typical.len() / 2].max(1e-9);
+                let x: Vec<f64> = fit
+                    .iter()
+                    .flat_map(|&i| f[i * d..(i + 1) * d].iter().copied())
+                    .collect();
+                let t: Vec<f64> = fit.iter().map(|&i| (base[i] + eps).ln()).collect();
+                let mut w = ridge(&x, &t, d).ok_or_else(|| {
+                    Error::Domain(format!("calibration on {part}: the difficulty fit failed"))
+                })?;
+                let dot = |i: usize| -> f64 {
+                    f[i * d..(i + 1) * d]
+                        .iter()
+                        .zip(&w)
+                        .map(|(a, b)| a * b)
+                        .sum()
+                };
+                let mut fitted: Vec<f64> = fit.iter().map(|&i| dot(i)).collect();
+                fitted.sort_by(f64::total_cmp);
+                w[0] -= fitted[fitted.len() / 2];
+                let dot = |i: usize| -> f64 {
+                    f[i * d..(i + 1) * d]
+                        .iter()
+                        .zip(&w)
+                        .map(|(a, b)| a * b)
+                        .sum()
+                };
+                for (i, l) in level.iter_mut().enumerate() {
+                    *l = dot(i).clamp(-5.0, 5.0).exp();
+                }
+                difficulty.push(w);
+            }
+            let cal: Vec<usize> = (0..n).filter(|&i| calibrates(i)).collect();
+            let mut scores: Vec<f64> = cal.iter().map(|&i| base[i] / level[i]).collect();
             scores.sort_by(f64::total_cmp);
-            quantiles.push(
-                (0..=LEVELS)
-                    .map(|i| {
-                        let c = i as f64 / LEVELS as f64;
-                        let rank = ((n + 1) as f64 * c).ceil() as usize;
-                        scores[rank.clamp(1, n) - 1]
-                    })
-                    .collect(),
-            );
+            quantiles.push(levels(&scores));
+            if features.is_some() {
+                let mut by_level: Vec<(f64, f64)> = cal
+                    .iter()
+                    .map(|&i| (level[i], base[i] / level[i]))
+                    .collect();
+                by_level.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let m = by_level.len();
+                let cut = |b: usize| b * m / BINS;
+                edges.push((1..BINS).map(|b| by_level[cut(b)].0).collect());
+                binned.push(
+                    (0..BINS)
+                        .map(|b| {
+                            let mut sb: Vec<f64> =
+                                by_level[cut(b)..cut(b + 1)].iter().map(|p| p.1).collect();
+                            sb.sort_by(f64::total_cmp);
+                            levels(&sb)
+                        })
+                        .collect(),
+                );
+            }
         }
         Ok(Calibration {
             score: if spread.is_some() {
@@ -108,9 +255,12 @@ impl Calibration {
             },
             beta,
             quantiles,
-            windows: n,
+            windows: (0..n).filter(|&i| calibrates(i)).count(),
             part,
             envelope: Vec::new(),
+            difficulty,
+            edges,
+            binned,
         })
     }
 
@@ -132,15 +282,43 @@ impl Calibration {
     }
 
     /// Half-width of target `k`'s interval at `coverage` (0–1) where the ensemble's spread is
-    /// `spread`, standardised units (the stored level at or above `coverage`).
-    pub fn half_width(&self, k: usize, coverage: f64, spread: f64) -> f64 {
+    /// `spread` and the window's difficulty [`Calibration::difficulty_of`] is `difficulty`,
+    /// standardised units (the stored level at or above `coverage`).
+    pub fn half_width(&self, k: usize, coverage: f64, spread: f64, difficulty: f64) -> f64 {
         let i = ((coverage.clamp(0.0, 1.0) * LEVELS as f64) - 1e-9).ceil() as usize;
-        let q = self.quantiles[k][i.min(LEVELS)];
+        let q = match (self.binned.get(k), self.edges.get(k)) {
+            (Some(bins), Some(edges)) => {
+                let b = edges.iter().take_while(|&&e| difficulty >= e).count();
+                bins[b.min(bins.len() - 1)][i.min(LEVELS)]
+            }
+            _ => self.quantiles[k][i.min(LEVELS)],
+        } * difficulty;
         if self.score == Score::Normalised {
             q * (spread + self.beta[k])
         } else {
             q
         }
+    }
+
+    /// Per target, the difficulty of a standardised window `[steps × c]` with the model's
+    /// standardised `prediction` (1 where the calibration has none; the median calibration
+    /// window's is 1).
+    pub fn difficulty_of(&self, window: &[f32], c: usize, prediction: &[f32]) -> Vec<f64> {
+        if self.difficulty.is_empty() {
+            return vec![1.0; self.quantiles.len()];
+        }
+        let f = features(window, c, prediction);
+        self.difficulty
+            .iter()
+            .map(|w| {
+                w.iter()
+                    .zip(&f)
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>()
+                    .clamp(-5.0, 5.0)
+                    .exp()
+            })
+            .collect()
     }
 }
 
@@ -178,13 +356,14 @@ mod tests {
                 &pc,
                 normalised.then_some(sc.as_slice()),
                 1,
+                None,
                 "planted".into(),
             )
             .unwrap();
             for coverage in [0.8, 0.9, 0.95] {
                 let inside = (0..yt.len())
                     .filter(|&i| {
-                        let h = cal.half_width(0, coverage, st[i] as f64);
+                        let h = cal.half_width(0, coverage, st[i] as f64, 1.0);
                         ((yt[i] - pt[i]).abs() as f64) <= h
                     })
                     .count() as f64
@@ -196,7 +375,7 @@ mod tests {
                 );
             }
             if normalised {
-                assert!(cal.half_width(0, 0.9, 0.25) < 0.6 * cal.half_width(0, 0.9, 1.0));
+                assert!(cal.half_width(0, 0.9, 0.25, 1.0) < 0.6 * cal.half_width(0, 0.9, 1.0, 1.0));
             }
         }
     }
@@ -204,8 +383,68 @@ mod tests {
     /// Mismatched lengths and non-finite predictions are refused, not calibrated on.
     #[test]
     fn calibration_refuses_bad_input() {
-        assert!(Calibration::fit(&[1.0, 2.0], &[1.0], None, 1, "x".into()).is_err());
-        assert!(Calibration::fit(&[1.0], &[f32::NAN], None, 1, "x".into()).is_err());
-        assert!(Calibration::fit(&[], &[], None, 1, "x".into()).is_err());
+        assert!(Calibration::fit(&[1.0, 2.0], &[1.0], None, 1, None, "x".into()).is_err());
+        assert!(Calibration::fit(&[1.0], &[f32::NAN], None, 1, None, "x".into()).is_err());
+        assert!(Calibration::fit(&[], &[], None, 1, None, "x".into()).is_err());
+        // Features of the wrong length, or too few windows to split into blocks.
+        assert!(Calibration::fit(&[1.0], &[1.0], None, 1, Some((&[1.0], 2)), "x".into()).is_err());
+    }
+
+    /// Planted: the error's σ grows with the inputs' level (five groups, 1× to 5×). One width
+    /// everywhere covers the pooled windows at the nominal rate but not each group; with the
+    /// window's difficulty every group is covered within ±2.5 % of nominal and the quiet
+    /// group's interval is narrower.
+    #[test]
+    fn difficulty_weighted_intervals_cover_every_level() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let unit = Normal::new(0.0, 1.0).unwrap();
+        let (c, steps) = (3, 20);
+        let mut draw = |n: usize| {
+            let (mut y, mut p, mut x, mut g) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            for i in 0..n {
+                // Groups change every 700 windows: both alternate 200-window blocks see all.
+                let group = (i / 700) % 5;
+                let level = 1.0 + group as f64;
+                let window: Vec<f32> = (0..c * steps)
+                    .map(|_| (level * unit.sample(&mut rng)) as f32)
+                    .collect();
+                x.extend(features(&window, c, &[0.0]));
+                y.push((0.2 * level * unit.sample(&mut rng)) as f32);
+                p.push(0.0f32);
+                g.push((group, window));
+            }
+            (y, p, x, g)
+        };
+        let (yc, pc, xc, _) = draw(21_000);
+        let (yt, pt, _, gt) = draw(35_000);
+        let uniform = Calibration::fit(&yc, &pc, None, 1, None, "planted".into()).unwrap();
+        let weighted = Calibration::fit(
+            &yc,
+            &pc,
+            None,
+            1,
+            Some((&xc, feature_count(c, 1))),
+            "planted".into(),
+        )
+        .unwrap();
+        assert_eq!(weighted.difficulty.len(), 1);
+        let covered = |cal: &Calibration, group: usize| {
+            let idx: Vec<usize> = (0..yt.len()).filter(|&i| gt[i].0 == group).collect();
+            idx.iter()
+                .filter(|&&i| {
+                    let d = cal.difficulty_of(&gt[i].1, c, &[0.0])[0];
+                    ((yt[i] - pt[i]).abs() as f64) <= cal.half_width(0, 0.9, 0.0, d)
+                })
+                .count() as f64
+                / idx.len() as f64
+        };
+        for group in 0..5 {
+            let w = covered(&weighted, group);
+            assert!((w - 0.9).abs() < 0.025, "group {group}: {w}");
+        }
+        assert!(covered(&uniform, 0) > 0.99 && covered(&uniform, 4) < 0.8);
+        let quiet =
+            weighted.half_width(0, 0.9, 0.0, weighted.difficulty_of(&gt[0].1, c, &[0.0])[0]);
+        assert!(quiet < 0.6 * uniform.half_width(0, 0.9, 0.0, 1.0));
     }
 }

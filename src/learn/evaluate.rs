@@ -73,12 +73,16 @@ pub fn evaluate(model: &mut Model, ds: &DataSet, part: EvalPart) -> Result<Evalu
     let windows_per_s = prep.test.len() as f64 / t0.elapsed().as_secs_f64().max(1e-9);
     let half_widths = model.meta.calibration.as_ref().map(|cal| {
         let o = prep.test.outputs;
+        let c = prep.test.channels;
+        let len = x.len() / prep.test.len().max(1);
         (0..prep.test.len())
             .map(|i| {
+                let level =
+                    cal.difficulty_of(&x[i * len..(i + 1) * len], c, &p[i * o..(i + 1) * o]);
                 (0..o)
                     .map(|k| {
                         let sp = spread.as_ref().map_or(0.0, |s| s[i * o + k] as f64);
-                        cal.half_width(k, EVAL_COVERAGE, sp) * stats.1.std[k]
+                        cal.half_width(k, EVAL_COVERAGE, sp, level[k]) * stats.1.std[k]
                     })
                     .collect()
             })

@@ -20,8 +20,15 @@ use std::path::Path;
 /// Windows predicted per batch while calibrating.
 const BATCH: usize = 8192;
 
-/// Calibrates `model` on the validation part of its own split of `ds`.
+/// Calibrates `model` on the validation part of its own split of `ds`, with each window's
+/// difficulty (the default: intervals follow the inputs' level, [`Calibration::difficulty`]).
 pub fn calibrate(model: &mut Model, ds: &DataSet) -> Result<Calibration> {
+    calibrate_with(model, ds, true)
+}
+
+/// [`calibrate`], with the window's difficulty or without it (one interval width everywhere,
+/// but for an ensemble's spread).
+pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Result<Calibration> {
     let spec = model.meta.data.clone();
     let stats = (
         model.meta.input_stats.clone(),
@@ -32,10 +39,16 @@ pub fn calibrate(model: &mut Model, ds: &DataSet) -> Result<Calibration> {
     let o = val.outputs;
     let (mut y, mut mean, mut spread) = (Vec::new(), Vec::new(), Vec::new());
     let (mut xb, mut yb) = (Vec::new(), Vec::new());
+    let c = val.channels;
+    let mut features = Vec::new();
     let idx: Vec<usize> = (0..val.len()).collect();
     for chunk in idx.chunks(BATCH) {
         val.gather(chunk, &mut xb, &mut yb);
+        let len = xb.len() / chunk.len().max(1);
         let (m, s) = model.predict_spread(&xb, chunk.len());
+        for (w, p) in xb.chunks(len.max(1)).zip(m.chunks(o)) {
+            features.extend(super::calibration::features(w, c, p));
+        }
         y.extend_from_slice(&yb);
         mean.extend(m);
         if let Some(s) = s {
@@ -49,6 +62,7 @@ pub fn calibrate(model: &mut Model, ds: &DataSet) -> Result<Calibration> {
         &mean,
         (!spread.is_empty()).then_some(spread.as_slice()),
         o,
+        difficulty.then_some((features.as_slice(), super::calibration::feature_count(c, o))),
         format!(
             "validation part of the model's split: {} windows of {} whole runs",
             val.len(),

@@ -304,7 +304,11 @@ impl Variation {
         } else {
             format!(" (with {})", self.with.join(", "))
         };
-        let scale = if self.scale { " × the file's value" } else { "" };
+        let scale = if self.scale {
+            " × the file's value"
+        } else {
+            ""
+        };
         format!("{}{with}: {draw}{scale}", self.key)
     }
 
