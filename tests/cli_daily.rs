@@ -214,6 +214,7 @@ fn every_help_example_runs() {
         "select",
         "train",
         "evaluate",
+        "calibrate",
         "identify",
         "export",
         "assess",

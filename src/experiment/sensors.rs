@@ -127,13 +127,16 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     })
 }
 
+/// A table of a report section: caption, table, file stem.
+type SectionTable = (String, Table, String);
+
 /// The Filter–Wrapper for FL and for FQ over the on-board candidates of `dsn` (noisy at the
 /// experiments' SNR): the union of the two selections (clean names) and each selection's table.
 pub(super) fn choose(
     ctx: &Ctx,
     dsn: &crate::dataset::DataSet,
     candidates: usize,
-) -> Result<(Vec<String>, Vec<(String, Table, String)>)> {
+) -> Result<(Vec<String>, Vec<SectionTable>)> {
     let opts = ctx.opts;
     let mut chosen: Vec<String> = Vec::new();
     let mut sel_tables = Vec::new();
