@@ -252,3 +252,85 @@ fn carbody_accelerations_in_their_band() {
     let by_hand = 7.08 * ((2.0f64 / 9.81).powi(3) * 7.2 / 3.0).powf(0.1);
     assert!((wz - by_hand).abs() < 0.01 && !pass, "{wz} vs {by_hand}");
 }
+
+/// Identified forces with intervals: a constant ±δ on Q moves the 99.85 % Q by exactly δ
+/// (a percentile shifts with a constant), the intervals hold the value, the probability of
+/// exceeding a limit grows with δ and is (1 − coverage)/2 where the high end meets the limit.
+#[test]
+fn statistics_of_identified_forces_carry_their_intervals() {
+    use railforce::assess::interval::{WheelBand, assess_with_bands, normal_quantile};
+    let r = run(300.0, |x, i| 20e3 * (x / 300.0) + noise(i, 3e3), |_, i| {
+        110e3 + noise(i + 7, 10e3)
+    });
+    let band = |dy: f64, dq: f64| -> Vec<WheelBand> {
+        r.wheels
+            .iter()
+            .map(|w| WheelBand {
+                y: [
+                    w.y.iter().map(|v| v - dy).collect(),
+                    w.y.iter().map(|v| v + dy).collect(),
+                ],
+                q: [
+                    w.q.iter().map(|v| v - dq).collect(),
+                    w.q.iter().map(|v| v + dq).collect(),
+                ],
+            })
+            .collect()
+    };
+    let c = Criteria::builtin();
+    let plain = assess(&r, &spans(), &c, 110.0).unwrap();
+    let a = assess_with_bands(&r, &band(2e3, 5e3), &spans(), &c, 110.0, 0.9).unwrap();
+    assert_eq!(a.rows, plain.rows, "the values are the plain assessment's");
+    assert_eq!(a.intervals.len(), a.rows.len());
+    for (row, b) in a.rows.iter().zip(&a.intervals) {
+        assert!(b.low <= row.value && row.value <= b.high, "{row:?} {b:?}");
+        assert!((0.0..=1.0).contains(&b.exceedance));
+    }
+    let q = a
+        .rows
+        .iter()
+        .position(|r| r.section == "tangent" && r.quantity == "Q" && r.place == "w1l")
+        .unwrap();
+    assert!((a.intervals[q].high - a.rows[q].value - 5.0).abs() < 1e-6);
+    assert!((a.rows[q].value - a.intervals[q].low - 5.0).abs() < 1e-6);
+    // Zero-width bands: the statistic is known, nothing within its limit can exceed it.
+    let exact = assess_with_bands(&r, &band(0.0, 0.0), &spans(), &c, 110.0, 0.9).unwrap();
+    for (row, b) in exact.rows.iter().zip(&exact.intervals) {
+        assert_eq!((b.low, b.high), (row.value, row.value));
+        assert_eq!(b.exceedance, if row.pass { 0.0 } else { 1.0 });
+    }
+    // Wider bands, likelier exceedance; where the high end meets the limit, (1 − 0.9)/2.
+    let wide = assess_with_bands(&r, &band(2e3, 40e3), &spans(), &c, 110.0, 0.9).unwrap();
+    assert!(wide.intervals[q].exceedance > a.intervals[q].exceedance);
+    let to_limit = (a.rows[q].limit - a.rows[q].value) * 1e3;
+    let meet = assess_with_bands(&r, &band(2e3, to_limit), &spans(), &c, 110.0, 0.9).unwrap();
+    assert!((meet.intervals[q].exceedance - 0.05).abs() < 1e-4, "{:?}", meet.intervals[q]);
+    assert!((normal_quantile(0.95) - 1.6449).abs() < 1e-4);
+    // The report says what the intervals are.
+    assert!(a.markdown().contains("P(exceed)") && a.table().csv().contains("p_exceed"));
+}
+
+/// identify's bound columns are read with the forces; one bound without the other is named.
+#[test]
+fn bound_columns_are_read_and_checked() {
+    use railforce::assess::interval::bands_from_columns;
+    let col = |n: &str, v: f64| (n.to_string(), vec![v; 400]);
+    let time = ("time_s".to_string(), (0..400).map(|i| i as f64 * 0.005).collect());
+    let s = ("s_m".to_string(), (0..400).map(|i| i as f64 * 0.05).collect());
+    let mut cols = vec![
+        time,
+        s,
+        col("w1l_force_y_N", 1e3),
+        col("w1l_force_z_N", 1e5),
+    ];
+    let r = RunForces::from_columns("x.csv", &cols).unwrap();
+    assert_eq!(bands_from_columns("x.csv", &cols, &r).unwrap(), None);
+    cols.push(col("w1l_force_y_lo_N", 0.5e3));
+    let e = bands_from_columns("x.csv", &cols, &r).unwrap_err().to_string();
+    assert!(e.contains("x.csv") && e.contains("w1l_force_y_hi_N"), "{e}");
+    cols.push(col("w1l_force_y_hi_N", 2e3));
+    cols.push(col("w1l_force_z_lo_N", 0.9e5));
+    cols.push(col("w1l_force_z_hi_N", 0.95e5));
+    let e = bands_from_columns("x.csv", &cols, &r).unwrap_err().to_string();
+    assert!(e.contains("w1l_force_z") && e.contains("around the value"), "{e}");
+}

@@ -10,6 +10,7 @@
 
 mod compare;
 pub mod criteria;
+pub mod interval;
 mod ride;
 pub mod safety;
 mod section;
@@ -201,6 +202,14 @@ pub struct Assessment {
     pub criteria: Criteria,
     /// Every quantity per section and place.
     pub rows: Vec<Row>,
+    /// Coverage of the identified forces' intervals the statistics' intervals come from
+    /// (identified forces with bounds, [`interval::assess_with_bands`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<f64>,
+    /// Per row, the statistic's interval and the probability its limit is exceeded (empty
+    /// without bounds).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub intervals: Vec<interval::RowInterval>,
 }
 
 /// Samples per second of a time column (median step).
@@ -265,6 +274,8 @@ pub fn assess(
         static_wheel_load_kn: q0_kn,
         criteria: criteria.clone(),
         rows,
+        coverage: None,
+        intervals: Vec::new(),
     })
 }
 
@@ -274,9 +285,11 @@ impl Assessment {
         self.rows.iter().filter(|r| !r.pass)
     }
 
-    /// The table (section, quantity, place, value, limit, unit, verdict, criterion).
+    /// The table (section, quantity, place, value, limit, unit, verdict, criterion; with
+    /// intervals, then the statistic's low and high end and the probability of exceeding the
+    /// limit).
     pub fn table(&self) -> crate::report::table::Table {
-        let mut t = crate::report::table::Table::new(&[
+        let mut head = vec![
             "section",
             "quantity",
             "place",
@@ -285,9 +298,13 @@ impl Assessment {
             "unit",
             "verdict",
             "criterion",
-        ]);
-        for r in &self.rows {
-            t.push(vec![
+        ];
+        if !self.intervals.is_empty() {
+            head.extend(["low", "high", "P(exceed)"]);
+        }
+        let mut t = crate::report::table::Table::new(&head);
+        for (i, r) in self.rows.iter().enumerate() {
+            let mut row = vec![
                 r.section.clone(),
                 r.quantity.clone(),
                 r.place.clone(),
@@ -296,7 +313,15 @@ impl Assessment {
                 r.unit.clone(),
                 if r.pass { "pass" } else { "FAIL" }.into(),
                 r.criterion.clone(),
-            ]);
+            ];
+            if let Some(b) = self.intervals.get(i) {
+                row.extend([
+                    format!("{:.4}", b.low),
+                    format!("{:.4}", b.high),
+                    format!("{:.4}", b.exceedance),
+                ]);
+            }
+            t.push(row);
         }
         t
     }
@@ -313,6 +338,13 @@ impl Assessment {
             self.rows.iter().filter(|r| r.pass).count(),
             self.rows.len()
         );
+        if let Some(c) = self.coverage {
+            s += &format!(
+                "Identified forces with their {:.0} % intervals: each statistic is recomputed with every wheel's Y and Q at the bounds (low and high: the smallest and largest over the four corners), and P(exceed) is the probability that the true statistic exceeds its limit, taking the statistic's error as normal with its central {:.0} % interval reaching the high end (an estimate: the errors of one run are taken to move together).\n\n",
+                100.0 * c,
+                100.0 * c
+            );
+        }
         s += &self.table().markdown();
         s += "\n## Sources\n\n";
         for (k, src) in [

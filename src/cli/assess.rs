@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use railforce::assess::{Criteria, RunForces, assess, spans};
+use railforce::assess::{Criteria, RunForces, assess, interval, spans};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
@@ -28,6 +28,11 @@ pub struct AssessArgs {
     /// Output folder for assessment.md, .csv and .json [default: FILE's name + _assessment].
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Coverage of the intervals in FILE (`identify --coverage`, 0.9 by default): where the
+    /// identified forces carry bounds (`w1l_force_y_lo_N`, `_hi_N`), each statistic gets its
+    /// interval and the probability its limit is exceeded.
+    #[arg(long, default_value_t = 0.9)]
+    coverage: f64,
 }
 
 /// The track a data set's manifest records for the run file `file`, if any.
@@ -67,7 +72,13 @@ pub fn run(args: AssessArgs) -> Result<()> {
             Vec::new()
         }
     };
-    let a = assess(&run, &sections, &criteria, q0)?;
+    let bands = interval::bands_from_columns(&args.file.display().to_string(), &cols, &run)?;
+    let a = match &bands {
+        Some(b) => {
+            interval::assess_with_bands(&run, b, &sections, &criteria, q0, args.coverage)?
+        }
+        None => assess(&run, &sections, &criteria, q0)?,
+    };
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .file
@@ -86,12 +97,25 @@ pub fn run(args: AssessArgs) -> Result<()> {
         w.write_all(json.as_bytes())
     })?;
     println!(
-        "{:<34} {:<22} {:<11} {:>10} {:>10} {:<4} verdict",
-        "section", "quantity", "place", "value", "limit", "unit"
+        "{:<34} {:<22} {:<11} {:>10} {:>10} {:<4} verdict{}",
+        "section",
+        "quantity",
+        "place",
+        "value",
+        "limit",
+        "unit",
+        if a.intervals.is_empty() {
+            ""
+        } else {
+            "  interval            P(exceed)"
+        }
     );
-    for r in &a.rows {
+    for (i, r) in a.rows.iter().enumerate() {
+        let band = a.intervals.get(i).map_or(String::new(), |b| {
+            format!("  {:>8.3}–{:<8.3}  {:>8.4}", b.low, b.high, b.exceedance)
+        });
         println!(
-            "{:<34} {:<22} {:<11} {:>10.3} {:>10.3} {:<4} {}",
+            "{:<34} {:<22} {:<11} {:>10.3} {:>10.3} {:<4} {}{band}",
             r.section,
             r.quantity,
             r.place,
