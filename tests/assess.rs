@@ -259,9 +259,11 @@ fn carbody_accelerations_in_their_band() {
 #[test]
 fn statistics_of_identified_forces_carry_their_intervals() {
     use railforce::assess::interval::{WheelBand, assess_with_bands, normal_quantile};
-    let r = run(300.0, |x, i| 20e3 * (x / 300.0) + noise(i, 3e3), |_, i| {
-        110e3 + noise(i + 7, 10e3)
-    });
+    let r = run(
+        300.0,
+        |x, i| 20e3 * (x / 300.0) + noise(i, 3e3),
+        |_, i| 110e3 + noise(i + 7, 10e3),
+    );
     let band = |dy: f64, dq: f64| -> Vec<WheelBand> {
         r.wheels
             .iter()
@@ -304,7 +306,11 @@ fn statistics_of_identified_forces_carry_their_intervals() {
     assert!(wide.intervals[q].exceedance > a.intervals[q].exceedance);
     let to_limit = (a.rows[q].limit - a.rows[q].value) * 1e3;
     let meet = assess_with_bands(&r, &band(2e3, to_limit), &spans(), &c, 110.0, 0.9).unwrap();
-    assert!((meet.intervals[q].exceedance - 0.05).abs() < 1e-4, "{:?}", meet.intervals[q]);
+    assert!(
+        (meet.intervals[q].exceedance - 0.05).abs() < 1e-4,
+        "{:?}",
+        meet.intervals[q]
+    );
     assert!((normal_quantile(0.95) - 1.6449).abs() < 1e-4);
     // The report says what the intervals are.
     assert!(a.markdown().contains("P(exceed)") && a.table().csv().contains("p_exceed"));
@@ -315,8 +321,14 @@ fn statistics_of_identified_forces_carry_their_intervals() {
 fn bound_columns_are_read_and_checked() {
     use railforce::assess::interval::bands_from_columns;
     let col = |n: &str, v: f64| (n.to_string(), vec![v; 400]);
-    let time = ("time_s".to_string(), (0..400).map(|i| i as f64 * 0.005).collect());
-    let s = ("s_m".to_string(), (0..400).map(|i| i as f64 * 0.05).collect());
+    let time = (
+        "time_s".to_string(),
+        (0..400).map(|i| i as f64 * 0.005).collect(),
+    );
+    let s = (
+        "s_m".to_string(),
+        (0..400).map(|i| i as f64 * 0.05).collect(),
+    );
     let mut cols = vec![
         time,
         s,
@@ -326,11 +338,18 @@ fn bound_columns_are_read_and_checked() {
     let r = RunForces::from_columns("x.csv", &cols).unwrap();
     assert_eq!(bands_from_columns("x.csv", &cols, &r).unwrap(), None);
     cols.push(col("w1l_force_y_lo_N", 0.5e3));
-    let e = bands_from_columns("x.csv", &cols, &r).unwrap_err().to_string();
+    let e = bands_from_columns("x.csv", &cols, &r)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("x.csv") && e.contains("w1l_force_y_hi_N"), "{e}");
     cols.push(col("w1l_force_y_hi_N", 2e3));
     cols.push(col("w1l_force_z_lo_N", 0.9e5));
     cols.push(col("w1l_force_z_hi_N", 0.95e5));
-    let e = bands_from_columns("x.csv", &cols, &r).unwrap_err().to_string();
-    assert!(e.contains("w1l_force_z") && e.contains("around the value"), "{e}");
+    let e = bands_from_columns("x.csv", &cols, &r)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("w1l_force_z") && e.contains("around the value"),
+        "{e}"
+    );
 }

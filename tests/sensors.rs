@@ -281,8 +281,40 @@ fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
         Some(railforce::learn::uncertainty::calibrate(&mut model, &ds).unwrap());
     let work = dir.join("closed_loop");
     let limits = Limits::default();
-    let checks = closed_loop::validate(&mut model, &plan, 1001, &work, 1, &limits, 0.2).unwrap();
+    let checks =
+        closed_loop::validate(&mut model, &plan, 1001, &work, 1, &limits, 0.2, None).unwrap();
     assert_eq!(checks.len(), 1);
+    // The same loop through a field recorder's conventions (its own column, g, the axis
+    // flipped, time in ms): written as RUN.field.csv, read back through the map, the same
+    // identification.
+    let first = model.meta.data.channels[0].clone();
+    let map_path = dir.join("map.toml");
+    std::fs::write(
+        &map_path,
+        format!(
+            "time = {{ column = \"Time\", unit = \"ms\" }}\n[channels]\n{first} = {{ column = \"ACC_1\", unit = \"g\", sign = -1 }}\n"
+        ),
+    )
+    .unwrap();
+    let map = railforce::identify::ChannelMap::load(&map_path).unwrap();
+    let field_work = dir.join("closed_loop_field");
+    let through = closed_loop::validate(
+        &mut model,
+        &plan,
+        1001,
+        &field_work,
+        1,
+        &limits,
+        0.2,
+        Some(&map),
+    )
+    .unwrap();
+    let rec = std::fs::read_to_string(field_work.join("tangent_seed1001.field.csv")).unwrap();
+    assert!(rec.starts_with("Time,") && rec.lines().next().unwrap().contains("ACC_1"));
+    assert!(!rec.lines().next().unwrap().contains(first.as_str()));
+    for (a, b) in checks[0].targets.iter().zip(&through[0].targets) {
+        assert!((a.r2 - b.r2).abs() < 1e-6 && (a.rmse_kn - b.rmse_kn).abs() < 1e-6);
+    }
     // The calibrated interval's coverage and width on the fresh run, per target.
     for t in &checks[0].targets {
         let (c, w) = (t.coverage.unwrap(), t.width_kn.unwrap());

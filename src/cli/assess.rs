@@ -74,9 +74,7 @@ pub fn run(args: AssessArgs) -> Result<()> {
     };
     let bands = interval::bands_from_columns(&args.file.display().to_string(), &cols, &run)?;
     let a = match &bands {
-        Some(b) => {
-            interval::assess_with_bands(&run, b, &sections, &criteria, q0, args.coverage)?
-        }
+        Some(b) => interval::assess_with_bands(&run, b, &sections, &criteria, q0, args.coverage)?,
         None => assess(&run, &sections, &criteria, q0)?,
     };
     let out = args.out.clone().unwrap_or_else(|| {

@@ -429,7 +429,11 @@ pub fn validate(
     jobs: usize,
     limits: &Limits,
     margin: f64,
+    channel_map: Option<&Path>,
 ) -> Result<()> {
+    let map = channel_map
+        .map(railforce::identify::channel_map::ChannelMap::load)
+        .transpose()?;
     if !(0.0..1.0).contains(&margin) {
         bail!("--margin {margin}: expected a fraction between 0 and 1 (0.2 = 20 %)");
     }
@@ -455,7 +459,14 @@ pub fn validate(
             .unwrap_or_else(|| "clean".into())
     );
     let runs = railforce::identify::closed_loop::validate(
-        &mut model, &plan, seed, &work, jobs, limits, margin,
+        &mut model,
+        &plan,
+        seed,
+        &work,
+        jobs,
+        limits,
+        margin,
+        map.as_ref(),
     )?;
     println!(
         "{:<22} {:<14} {:>7} {:>9} {:>12} {:>13} {:>13}",

@@ -36,6 +36,12 @@ enum What {
         /// Warn where an identified statistic is more than this fraction below the true one.
         #[arg(long, default_value_t = railforce::identify::closed_loop::UNDER_MARGIN)]
         margin: f64,
+        /// Close the loop through a field recording's conventions: each fresh run is written
+        /// as this channel map's recorder would write it (its columns, units and signs, as
+        /// RUN.field.csv) and read back through the map, as `identify --channel-map` reads a
+        /// recording.
+        #[arg(long)]
+        channel_map: Option<PathBuf>,
         #[command(flatten)]
         limits: super::identify::LimitArgs,
     },
@@ -86,8 +92,17 @@ pub fn run(args: ValidateArgs) -> Result<()> {
             seed,
             jobs,
             margin,
+            channel_map,
             limits,
-        } => super::identify::validate(&model, &plan, seed, jobs, &limits.limits()?, margin),
+        } => super::identify::validate(
+            &model,
+            &plan,
+            seed,
+            jobs,
+            &limits.limits()?,
+            margin,
+            channel_map.as_deref(),
+        ),
         What::Contact { reference_dir } => contact(&match reference_dir {
             Some(d) => cv::Reference::Dir(d),
             None => cv::Reference::Builtin,

@@ -217,6 +217,44 @@ impl ChannelMap {
         Ok(out)
     }
 
+    /// The columns a recorder following this map writes for the model's `channels` of
+    /// `table` (each from its `_noisy` copy where the table has one: a recorder's values are
+    /// noisy), with the track position `s_m` where the table has it: the map's time column in
+    /// its unit, each mapped channel under its column in its unit and sign, the others under
+    /// their own names. [`ChannelMap::read`] of a file of these columns gives the channels back:
+    /// closed-loop validation through a field recording's conventions.
+    pub fn record(
+        &self,
+        table: &SensorTable,
+        channels: &[String],
+    ) -> Result<Vec<(String, Vec<f64>)>> {
+        let factor = |m: &Mapping| m.unit.as_deref().and_then(unit).map_or(1.0, |u| u.1) * m.sign;
+        let mut out = vec![match &self.time {
+            Some(t) => (
+                t.column.clone(),
+                table.time.iter().map(|v| v / factor(t)).collect(),
+            ),
+            None => ("time_s".to_string(), table.time.clone()),
+        }];
+        if let Some(s) = table.column("s_m") {
+            out.push(("s_m".into(), s.to_vec()));
+        }
+        for c in channels {
+            let noisy = crate::sensors::noisy_name(c);
+            let v = table
+                .column(&noisy)
+                .or_else(|| table.column(c))
+                .ok_or_else(|| {
+                    Error::Domain(format!("{}: no channel {c} to record", table.source))
+                })?;
+            out.push(match self.channels.get(c) {
+                Some(m) => (m.column.clone(), v.iter().map(|x| x / factor(m)).collect()),
+                None => (c.clone(), v.to_vec()),
+            });
+        }
+        Ok(out)
+    }
+
     /// What the output's metadata records.
     pub fn describe(&self) -> serde_json::Value {
         serde_json::to_value(self).unwrap_or_default()

@@ -2,6 +2,7 @@
 //! identify the forces from their sensor channels, and compare with the simulator's truth —
 //! R², RMSE, peak error and whether the safety verdicts agree.
 
+use super::channel_map::ChannelMap;
 use super::safety::{Limits, indices};
 use super::{Identified, SensorTable, check, identify_with_bands};
 use crate::dataset::DataSet;
@@ -135,6 +136,7 @@ pub fn fresh_seed(model: &Model) -> u64 {
 }
 
 /// Runs the check on every condition of `plan` with `seed`, writing the fresh data to `work`.
+#[allow(clippy::too_many_arguments)]
 pub fn validate(
     model: &mut Model,
     plan: &Plan,
@@ -143,6 +145,7 @@ pub fn validate(
     jobs: usize,
     limits: &Limits,
     margin: f64,
+    map: Option<&ChannelMap>,
 ) -> Result<Vec<RunCheck>> {
     let used: Vec<u64> = model.meta.data_identity["seeds"]
         .as_array()
@@ -182,8 +185,16 @@ pub fn validate(
             .cloned()
             .zip(run.columns.iter().cloned())
             .collect();
-        let table =
+        let mut table =
             SensorTable::from_columns(format!("{} seed {}", run.condition, run.seed), cols)?;
+        if let Some(map) = map {
+            // Through the field's conventions: written as the map's recorder would write it
+            // (columns, units, signs), read back as `identify --channel-map` reads a recording.
+            let field = map.record(&table, &model.meta.data.channels)?;
+            let path = work.join(format!("{}_seed{}.field.csv", run.condition, run.seed));
+            write_columns(&path, &field)?;
+            table = map.read(&path, &model.meta.data.channels)?;
+        }
         let input = check(&table, model, false)?;
         let (id, bands) =
             identify_with_bands(model, &input, Some(crate::learn::evaluate::EVAL_COVERAGE));
@@ -318,4 +329,25 @@ mod tests {
         let checks = compare_indices(&truth, &id, &Limits::default(), UNDER_MARGIN);
         assert!(checks.iter().all(|c| !c.underestimated));
     }
+}
+
+/// Writes columns as CSV (shortest round-trip decimals), atomically.
+fn write_columns(path: &Path, cols: &[(String, Vec<f64>)]) -> Result<()> {
+    let n = cols.first().map_or(0, |c| c.1.len());
+    crate::io::write_atomic(path, |w| {
+        let head: Vec<&str> = cols.iter().map(|c| c.0.as_str()).collect();
+        writeln!(w, "{}", head.join(","))?;
+        let mut line = String::new();
+        for i in 0..n {
+            line.clear();
+            for (k, (_, v)) in cols.iter().enumerate() {
+                if k > 0 {
+                    line.push(',');
+                }
+                line.push_str(&v[i].to_string());
+            }
+            writeln!(w, "{line}")?;
+        }
+        Ok(())
+    })
 }

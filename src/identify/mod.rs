@@ -70,7 +70,8 @@ impl SensorTable {
         })
     }
 
-    fn column(&self, name: &str) -> Option<&[f64]> {
+    /// The column `name`, if the table has it.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
         self.columns
             .iter()
             .find(|(n, _)| n == name)

@@ -71,6 +71,10 @@ pub struct Calibration {
 /// Difficulty bins of the Mondrian calibration.
 const BINS: usize = 5;
 
+/// Validation windows below which the difficulty is not fitted (one width everywhere): ten
+/// blocks, so each bin holds at least 200 calibrating windows.
+pub const MIN_WEIGHTED: usize = 10 * BLOCK;
+
 /// The conformal quantile of sorted `scores` at every level `i / LEVELS`: the
 /// `⌈(n+1)·c⌉`-th smallest.
 fn levels(scores: &[f64]) -> Vec<f64> {
@@ -154,12 +158,13 @@ impl Calibration {
             || mean.len() != y.len()
             || spread.is_some_and(|s| s.len() != y.len())
             || features.is_some_and(|(f, d)| f.len() != n * d)
-            || features.is_some() && n < 4 * BLOCK
         {
             return Err(Error::Domain(format!(
                 "calibration needs windows with one prediction each ({part})"
             )));
         }
+        // Too few windows to fit a difficulty and fill its bins: one width everywhere.
+        let features = features.filter(|_| n >= MIN_WEIGHTED);
         let mut beta = vec![0.0; outputs];
         let mut quantiles = Vec::with_capacity(outputs);
         let mut difficulty = Vec::new();
@@ -386,8 +391,19 @@ mod tests {
         assert!(Calibration::fit(&[1.0, 2.0], &[1.0], None, 1, None, "x".into()).is_err());
         assert!(Calibration::fit(&[1.0], &[f32::NAN], None, 1, None, "x".into()).is_err());
         assert!(Calibration::fit(&[], &[], None, 1, None, "x".into()).is_err());
-        // Features of the wrong length, or too few windows to split into blocks.
+        // Features of the wrong length.
         assert!(Calibration::fit(&[1.0], &[1.0], None, 1, Some((&[1.0], 2)), "x".into()).is_err());
+        // Too few windows to fit a difficulty: one width everywhere.
+        let few = Calibration::fit(
+            &[1.0, 2.0],
+            &[1.5, 1.5],
+            None,
+            1,
+            Some((&[1.0, 1.0], 1)),
+            "x".into(),
+        )
+        .unwrap();
+        assert!(few.difficulty.is_empty() && few.binned.is_empty());
     }
 
     /// Planted: the error's σ grows with the inputs' level (five groups, 1× to 5×). One width
