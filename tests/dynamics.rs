@@ -392,3 +392,54 @@ fn restrained_wheelset_wickens_critical_speed() {
         k.expected
     );
 }
+
+/// The step profile: off by default; on, it counts every step and names every part (the
+/// patch solve eight times a step), and leaves the motion exactly as an unprofiled run's; the
+/// element costs name every kind with its count.
+#[test]
+fn a_profiled_step_names_its_parts_and_changes_nothing() {
+    let t = Track::new(
+        TrackSpec::load(&root().join("tracks/tangent.toml")).unwrap(),
+        Some(2),
+    );
+    let cfg = SimConfig {
+        speed: 80.0 / 3.6,
+        duration: 0.1,
+        settle: 0.0,
+        ..SimConfig::default()
+    };
+    let mut plain = Simulation::new(c80(), &t, cfg.clone()).unwrap();
+    let mut profiled = Simulation::new(c80(), &t, cfg).unwrap();
+    assert!(plain.profile().is_none());
+    profiled.set_profiling(true);
+    for _ in 0..200 {
+        plain.step().unwrap();
+        profiled.step().unwrap();
+    }
+    assert_eq!(
+        plain.states(),
+        profiled.states(),
+        "profiling changes no number"
+    );
+    let p = profiled.profile().unwrap();
+    assert_eq!(p.steps, 200);
+    let parts = p.per_step(0.0);
+    for (name, calls) in [
+        ("force elements", 1.0),
+        ("contact (8 wheels)", 1.0),
+        ("  of which the patch solve (8 wheels)", 8.0),
+        ("integration (11 bodies)", 1.0),
+        ("checks", 1.0),
+    ] {
+        let part = parts.iter().find(|q| q.0 == name).expect(name);
+        assert_eq!(part.2, calls, "{name}");
+        assert!(part.1 >= 0.0 && part.1.is_finite());
+    }
+    let kinds = profiled.element_costs(10);
+    let pads = kinds.iter().find(|k| k.0 == "shear_pad").unwrap();
+    assert_eq!(pads.1, 8, "eight axle-box pads");
+    assert_eq!(
+        kinds.iter().map(|k| k.1).sum::<usize>(),
+        c80().elements.len()
+    );
+}

@@ -17,6 +17,7 @@ pub mod fidelity;
 mod filter;
 pub mod modes;
 pub mod output;
+pub mod profile;
 mod track_frame;
 mod wheel_rail;
 
@@ -28,6 +29,7 @@ use crate::error::{Error, Result};
 use crate::track::Track;
 use crate::vehicle::{BodyState, Element, Vehicle, Wrench};
 use nalgebra::{UnitQuaternion, Vector3};
+use profile::{StepProfile, timed};
 
 /// Settings of a run.
 #[derive(Debug, Clone)]
@@ -131,6 +133,8 @@ pub struct Simulation<'a> {
     pub wheels: Vec<WheelResult>,
     /// Accelerations of each body at the last step, world, m/s².
     pub accelerations: Vec<Vector3<f64>>,
+    /// Where the steps' time goes, when profiling is on ([`Simulation::set_profiling`]).
+    profile: Option<Box<StepProfile>>,
 }
 
 impl<'a> Simulation<'a> {
@@ -296,6 +300,7 @@ impl<'a> Simulation<'a> {
             cfg,
             wheels: vec![WheelResult::default(); n_wheels],
             accelerations: vec![Vector3::zeros(); n],
+            profile: None,
         })
     }
 
@@ -378,7 +383,8 @@ impl<'a> Simulation<'a> {
     pub fn step(&mut self) -> Result<()> {
         let dt = self.cfg.dt;
         self.forces(true)?;
-        self.move_rails();
+        timed!(self.profile, "rails", self.move_rails());
+        let t0 = self.profile.is_some().then(std::time::Instant::now);
         // Semi-implicit Euler: velocities first, positions with the new velocities.
         for (i, (st, w)) in self.states.iter_mut().zip(&self.wrenches).enumerate() {
             let b = &self.vehicle.bodies[i];
@@ -395,8 +401,22 @@ impl<'a> Simulation<'a> {
             st.angular_velocity = rot * wb;
             st.rotation = rot * UnitQuaternion::from_scaled_axis(wb * dt);
         }
+        if let (Some(t0), Some(p)) = (t0, self.profile.as_deref_mut()) {
+            p.add("integration (11 bodies)", t0.elapsed());
+            p.steps += 1;
+        }
         self.time += dt;
-        self.check()
+        timed!(self.profile, "checks", self.check())
+    }
+
+    /// Turns the step profile on (cleared) or off ([`profile::StepProfile`]).
+    pub fn set_profiling(&mut self, on: bool) {
+        self.profile = on.then(Box::default);
+    }
+
+    /// The step profile so far, when profiling is on.
+    pub fn profile(&self) -> Option<&StepProfile> {
+        self.profile.as_deref()
     }
 
     /// Every force of the state as it stands: gravity, the force elements, the track springs,
@@ -410,23 +430,29 @@ impl<'a> Simulation<'a> {
             *w = Wrench::default();
             w.force.z = -b.mass * g;
         }
-        for (e, m) in self.vehicle.elements.iter().zip(&mut self.memory) {
-            e.apply(&self.states, m, &mut self.wrenches);
-        }
+        timed!(self.profile, "force elements", {
+            for (e, m) in self.vehicle.elements.iter().zip(&mut self.memory) {
+                e.apply(&self.states, m, &mut self.wrenches);
+            }
+        });
         // Wheelsets (contact) and the hauled body need their track frame every step; the
         // others only when signals are sampled or the state is checked.
-        for k in 0..self.every_step.len() {
-            let i = self.every_step[k];
-            self.refresh_frame(i);
-        }
-        for e in &self.vehicle.elements {
-            if let Element::TrackSpring(ts) = e {
-                let f = &self.frames[ts.body];
-                ts.restore(&self.states, &f.origin, &f.axes, &mut self.wrenches);
+        timed!(self.profile, "track frames", {
+            for k in 0..self.every_step.len() {
+                let i = self.every_step[k];
+                self.refresh_frame(i);
             }
-        }
-        self.contact()?;
-        self.haul(integrate_haul);
+        });
+        timed!(self.profile, "track springs", {
+            for e in &self.vehicle.elements {
+                if let Element::TrackSpring(ts) = e {
+                    let f = &self.frames[ts.body];
+                    ts.restore(&self.states, &f.origin, &f.axes, &mut self.wrenches);
+                }
+            }
+        });
+        timed!(self.profile, "contact (8 wheels)", self.contact())?;
+        timed!(self.profile, "hauling", self.haul(integrate_haul));
         Ok(())
     }
 

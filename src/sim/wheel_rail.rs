@@ -111,7 +111,11 @@ impl Simulation<'_> {
             let (inputs, y_centre) = self.wheels_on_rails(w);
             for (k, wr) in inputs.into_iter().enumerate() {
                 let idx = 2 * w + k;
-                let out = evaluate(self.table, &model, &wr);
+                let out = super::profile::timed!(
+                    self.profile,
+                    "  of which the patch solve (8 wheels)",
+                    evaluate(self.table, &model, &wr)
+                );
                 self.inputs[idx] = wr;
                 let force = f.axes * Vector3::from(out.force);
                 self.wrenches[b].force += force;

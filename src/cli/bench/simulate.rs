@@ -7,7 +7,7 @@ use railforce::vehicle::Vehicle;
 use std::time::Instant;
 
 /// Result of the simulation benchmark.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct SimulateBench {
     /// Integration step, s.
     pub dt: f64,
@@ -19,6 +19,13 @@ pub struct SimulateBench {
     pub real_time_factor: f64,
     /// Simulated over wall time, with recording.
     pub real_time_factor_recorded: f64,
+    /// Where a recorded step's time goes (a third run, profiled): part, µs per step, calls
+    /// per step; the clock's own cost taken off.
+    pub profile: Vec<(String, f64, f64)>,
+    /// µs per step of that profiled run (clock included).
+    pub profiled_step_us: f64,
+    /// Per element kind: count and ns per `apply` (measured apart, on the run's last state).
+    pub elements: Vec<(&'static str, usize, f64)>,
 }
 
 /// Runs `seconds` of simulated time twice (physics only, then with the recorder) at `speed` on
@@ -31,6 +38,12 @@ pub fn run(vehicle: &Vehicle, track: &Track, speed: f64, seconds: f64) -> Result
         ..SimConfig::default()
     };
     let dt = cfg.dt;
+    let cfg_profiled = |speed, duration| SimConfig {
+        speed,
+        duration,
+        settle: 0.0,
+        ..SimConfig::default()
+    };
     let steps = (seconds / dt).round() as usize;
     let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
     let t = Instant::now();
@@ -50,7 +63,35 @@ pub fn run(vehicle: &Vehicle, track: &Track, speed: f64, seconds: f64) -> Result
     }
     std::hint::black_box(acc);
     let recorded = t.elapsed().as_secs_f64();
+    // Profiled: the same run with the clock read around every part of the step, and around
+    // the recorder.
+    let clock = railforce::sim::profile::clock_cost_ns();
+    let mut sim = Simulation::new(vehicle, track, cfg_profiled(speed, seconds))?;
+    let mut rec = Recorder::new(&sim);
+    sim.set_profiling(true);
+    let (mut rec_time, mut acc) = (std::time::Duration::ZERO, 0.0);
+    let t = Instant::now();
+    for _ in 0..steps {
+        sim.step()?;
+        let t0 = Instant::now();
+        if let Some(row) = rec.sample(&mut sim) {
+            acc += row[2];
+        }
+        rec_time += t0.elapsed();
+    }
+    std::hint::black_box(acc);
+    let profiled = t.elapsed().as_secs_f64();
+    let mut profile = sim.profile().map(|p| p.per_step(clock)).unwrap_or_default();
+    profile.push((
+        "recording (every channel computed and filtered each step)".into(),
+        (rec_time.as_secs_f64() * 1e9 - clock * steps as f64).max(0.0) * 1e-3 / steps as f64,
+        1.0,
+    ));
+    let elements = sim.element_costs(20_000);
     Ok(SimulateBench {
+        elements,
+        profile,
+        profiled_step_us: profiled * 1e6 / steps as f64,
         dt,
         step_us: plain * 1e6 / steps as f64,
         step_recorded_us: recorded * 1e6 / steps as f64,
