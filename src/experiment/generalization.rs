@@ -85,8 +85,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         "Var(FQ_test)",
         "paper FQ MSE",
         "paper FQ R²",
-        "FL covered",
-        "FQ covered",
+        "FL covered %",
+        "FQ covered %",
         "FL width kN",
         "FQ width kN",
     ]);
@@ -97,8 +97,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let covered = |c: &str| -> Vec<String> {
         match coverage.iter().find(|r| r.condition == c) {
             Some(r) => vec![
-                format!("{:.1} %", 100.0 * r.targets[0].0),
-                format!("{:.1} %", 100.0 * r.targets[1].0),
+                format!("{:.1}", 100.0 * r.targets[0].0),
+                format!("{:.1}", 100.0 * r.targets[1].0),
                 format!("{:.2}", r.targets[0].1),
                 format!("{:.2}", r.targets[1].1),
             ],

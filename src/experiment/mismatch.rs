@@ -274,11 +274,11 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         "FL RMSE kN",
         "FQ R²",
         "FQ RMSE kN",
-        "FL covered",
-        "FQ covered",
+        "FL covered %",
+        "FQ covered %",
         "FL width kN",
         "FQ width kN",
-        "flagged",
+        "flagged %",
         "FL RMSE flagged kN",
         "FL RMSE quiet kN",
         "FQ RMSE flagged kN",
@@ -296,7 +296,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     if width {
                         format!("{w:.2}")
                     } else {
-                        format!("{:.1} %", 100.0 * c)
+                        format!("{:.1}", 100.0 * c)
                     }
                 })
             };
@@ -305,7 +305,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 MISSING.to_string()
             } else {
                 format!(
-                    "{:.1} %",
+                    "{:.1}",
                     100.0 * flags.iter().filter(|&&f| f).count() as f64 / flags.len() as f64
                 )
             };
