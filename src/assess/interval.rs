@@ -187,7 +187,7 @@ pub fn normal_cdf(x: f64) -> f64 {
     }
 }
 
-/// Φ⁻¹ by bisection on [`normal_cdf`] (to 1e-10).
+/// Φ⁻¹ by bisection on [`normal_cdf`] (to its own accuracy, about 1e-7).
 pub fn normal_quantile(p: f64) -> f64 {
     let (mut lo, mut hi) = (-10.0, 10.0);
     for _ in 0..100 {
@@ -212,6 +212,6 @@ mod tests {
         assert!((normal_cdf(1.959_964) - 0.975).abs() < 1e-6);
         assert!((normal_cdf(-1.644_854) - 0.05).abs() < 1e-6);
         assert!((normal_quantile(0.95) - 1.644_854).abs() < 1e-5);
-        assert!((normal_quantile(0.5)).abs() < 1e-9);
+        assert!(normal_quantile(0.5).abs() < 1e-6);
     }
 }

@@ -17,6 +17,7 @@ use crate::report::svg::{BarChart, BarSeries, WIDTH};
 use crate::report::table::{MISSING, Table};
 use crate::sensors::Candidates;
 use crate::vary::Vary;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The named extremes: folder, what it is, and its `[vary]` table (one fixed value on the
@@ -91,6 +92,33 @@ fn extreme(plan: &Plan, name: &str, table: &str, seeds: &[u64]) -> Result<Plan> 
     Ok(p)
 }
 
+/// The model an earlier run of the experiments left in `dir` (the generalisation's or the
+/// sensors' CNN-BiLSTM), when it was trained on the same data under the same protocol
+/// (`channels`, or its own) and calibrated with its envelope: reused, not trained again.
+fn earlier(ctx: &Ctx, dir: &Path, ds: &DataSet, channels: Option<&[String]>) -> Option<Model> {
+    let m = Model::load(dir).ok()?;
+    let channels = channels.map_or_else(|| m.meta.data.channels.clone(), |c| c.to_vec());
+    let mut spec = ctx
+        .spec(
+            ds,
+            &channels,
+            &ctx.labels(),
+            NoiseProtocol::Matched,
+            ctx.split.clone(),
+        )
+        .ok()?;
+    // The noise the experiments train with (`ds` may be the clean data).
+    spec.noise_model = Some(ctx.opts.noise(ctx.opts.snr_db));
+    let same = m.meta.kind == ModelKind::CnnBiLstm
+        && m.meta.data == spec
+        && m.meta.data_identity["data_fnv1a"].as_str() == Some(ctx.data_hash.as_str())
+        && m.meta
+            .calibration
+            .as_ref()
+            .is_some_and(|c| !c.envelope.is_empty());
+    same.then_some(m)
+}
+
 /// One test set: name, what it is, its data (noisy inputs), which windows.
 struct TestSet {
     name: String,
@@ -134,9 +162,18 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let dir = opts.out.join("mismatch");
     let labels = ctx.labels();
     let paper = Ctx::paper21();
-    let selected = match &ctx.selected {
-        Some(s) => s.clone(),
-        None => {
+    let selected_dir = opts
+        .out
+        .join(format!("sensors/models/selected_{}dB", opts.snr_db));
+    let paper21_dir = opts.out.join("generalization/models/all_conditions");
+    let earlier_selected = match &ctx.selected {
+        Some(_) => None,
+        None => earlier(ctx, &selected_dir, &ctx.ds, None),
+    };
+    let selected = match (&ctx.selected, &earlier_selected) {
+        (Some(s), _) => s.clone(),
+        (None, Some(m)) => m.meta.data.channels.clone(),
+        (None, None) => {
             let onboard = ctx
                 .ds
                 .distinct_channels(&Candidates::Onboard.among(&ctx.ds.names, &ctx.ds.labels));
@@ -212,10 +249,23 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         (SELECTED, "selected on-board", &selected),
     ];
     let mut jobs = Vec::new();
-    let mut reused = Vec::new();
+    let mut reused: Vec<Option<PathBuf>> = Vec::new();
     for (key, _, ins) in cases {
+        let dir = if key == PAPER21 {
+            &paper21_dir
+        } else {
+            &selected_dir
+        };
+        let on_disk = || earlier(ctx, dir, nominal_ds, Some(ins)).map(|_| dir.clone());
         match ctx.trained.iter().find(|(k, _)| *k == key) {
             Some((_, d)) => reused.push(Some(d.clone())),
+            None if on_disk().is_some() => {
+                (ctx.log)(format!(
+                    "reusing {} (trained earlier on the same data and protocol)",
+                    dir.display()
+                ));
+                reused.push(on_disk());
+            }
             None => {
                 reused.push(None);
                 jobs.push(FitJob {
@@ -381,7 +431,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     .collect::<Vec<_>>()
                     .join("; ")
             ),
-            "Trained on the nominal wagon: the generalisation (paper's 21) and sensors (on-board selection) experiments' CNN-BiLSTMs where they ran in the same invocation. Trained on the fleet (domain randomisation): the same network, inputs, split and noise on the fleet's training and validation seeds. Every model is calibrated by split conformal on its own validation runs: \"covered\" is the share of true forces inside its 90 % interval, \"flagged\" the share of windows with an input beyond its training envelope (the rule `identify` warns by), and the RMSE where flagged against where quiet says whether the flag fires where the error is large.".into(),
+            "Trained on the nominal wagon: the generalisation (paper's 21) and sensors (on-board selection) experiments' CNN-BiLSTMs where they ran in the same invocation, or earlier into the same folder on the same data and protocol. Trained on the fleet (domain randomisation): the same network, inputs, split and noise on the fleet's training and validation seeds. Every model is calibrated by split conformal on its own validation runs: \"covered\" is the share of true forces inside its 90 % interval, \"flagged\" the share of windows with an input beyond its training envelope (the rule `identify` warns by), and the RMSE where flagged against where quiet says whether the flag fires where the error is large.".into(),
             ctx.protocol(&ctx.split, Some(opts.snr_db)),
             format!(
                 "Time: simulation {sim_s:.0} s, trainings {train_s:.0} s ({} networks), evaluation {eval_s:.0} s; the part {:.0} s. Intervals at {:.0} %.",

@@ -205,6 +205,9 @@ struct Ctx<'a> {
     trained: Vec<(&'static str, PathBuf)>,
     /// The on-board selection (union for FL and FQ) once the sensors experiment made it.
     selected: Option<Vec<String>>,
+    /// Identity of the data (`data_fnv1a`): a model an earlier run left on the same data may
+    /// be reused.
+    data_hash: String,
 }
 
 /// [`Ctx::trained`]: the all-condition CNN-BiLSTM on the paper's 21.
@@ -557,6 +560,7 @@ pub fn run(
         pooled: None,
         trained: Vec::new(),
         selected: None,
+        data_hash: data_hash.clone(),
     };
     let mut timings = serde_json::Map::new();
     let common = json!({

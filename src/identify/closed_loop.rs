@@ -290,6 +290,27 @@ pub fn validate(
     Ok(out)
 }
 
+/// Writes columns as CSV (shortest round-trip decimals), atomically.
+fn write_columns(path: &Path, cols: &[(String, Vec<f64>)]) -> Result<()> {
+    let n = cols.first().map_or(0, |c| c.1.len());
+    crate::io::write_atomic(path, |w| {
+        let head: Vec<&str> = cols.iter().map(|c| c.0.as_str()).collect();
+        writeln!(w, "{}", head.join(","))?;
+        let mut line = String::new();
+        for i in 0..n {
+            line.clear();
+            for (k, (_, v)) in cols.iter().enumerate() {
+                if k > 0 {
+                    line.push(',');
+                }
+                line.push_str(&v[i].to_string());
+            }
+            writeln!(w, "{line}")?;
+        }
+        Ok(())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -329,25 +350,4 @@ mod tests {
         let checks = compare_indices(&truth, &id, &Limits::default(), UNDER_MARGIN);
         assert!(checks.iter().all(|c| !c.underestimated));
     }
-}
-
-/// Writes columns as CSV (shortest round-trip decimals), atomically.
-fn write_columns(path: &Path, cols: &[(String, Vec<f64>)]) -> Result<()> {
-    let n = cols.first().map_or(0, |c| c.1.len());
-    crate::io::write_atomic(path, |w| {
-        let head: Vec<&str> = cols.iter().map(|c| c.0.as_str()).collect();
-        writeln!(w, "{}", head.join(","))?;
-        let mut line = String::new();
-        for i in 0..n {
-            line.clear();
-            for (k, (_, v)) in cols.iter().enumerate() {
-                if k > 0 {
-                    line.push(',');
-                }
-                line.push_str(&v[i].to_string());
-            }
-            writeln!(w, "{line}")?;
-        }
-        Ok(())
-    })
 }
