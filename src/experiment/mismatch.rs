@@ -248,6 +248,16 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         (PAPER21, "paper's 21", &paper),
         (SELECTED, "selected on-board", &selected),
     ];
+    let job = |fleet: bool, ins: &[String], name: String| -> Result<FitJob> {
+        let ds = if fleet { fleet_ds } else { nominal_ds };
+        Ok(FitJob {
+            ds,
+            spec: ctx.spec(ds, ins, &labels, NoiseProtocol::Matched, ctx.split.clone())?,
+            kind: ModelKind::CnnBiLstm,
+            dir: dir.join(format!("models/{name}")),
+            windows: None,
+        })
+    };
     let mut jobs = Vec::new();
     let mut reused: Vec<Option<PathBuf>> = Vec::new();
     for (key, _, ins) in cases {
@@ -268,36 +278,12 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             }
             None => {
                 reused.push(None);
-                jobs.push(FitJob {
-                    ds: nominal_ds,
-                    spec: ctx.spec(
-                        nominal_ds,
-                        ins,
-                        &labels,
-                        NoiseProtocol::Matched,
-                        ctx.split.clone(),
-                    )?,
-                    kind: ModelKind::CnnBiLstm,
-                    dir: dir.join(format!("models/nominal_{key}")),
-                    windows: None,
-                });
+                jobs.push(job(false, ins, format!("nominal_{key}"))?);
             }
         }
     }
     for (key, _, ins) in cases {
-        jobs.push(FitJob {
-            ds: fleet_ds,
-            spec: ctx.spec(
-                fleet_ds,
-                ins,
-                &labels,
-                NoiseProtocol::Matched,
-                ctx.split.clone(),
-            )?,
-            kind: ModelKind::CnnBiLstm,
-            dir: dir.join(format!("models/fleet_{key}")),
-            windows: None,
-        });
+        jobs.push(job(true, ins, format!("fleet_{key}"))?);
     }
     let tt = Instant::now();
     let mut fitted = ctx.fit_all(&jobs)?.into_iter().map(|(m, _)| m);

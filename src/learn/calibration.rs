@@ -117,6 +117,11 @@ pub fn feature_count(c: usize, outputs: usize) -> usize {
     1 + c + 2 * outputs
 }
 
+/// `a · b`.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
 /// Ridge least squares `(XᵀX + λ·n·I)⁻¹ Xᵀ t` (the bias unpenalised) of rows `x[n × d]`.
 fn ridge(x: &[f64], t: &[f64], d: usize) -> Option<Vec<f64>> {
     let n = t.len();
@@ -205,25 +210,12 @@ impl Calibration {
                 let mut w = ridge(&x, &t, d).ok_or_else(|| {
                     Error::Domain(format!("calibration on {part}: the difficulty fit failed"))
                 })?;
-                let dot = |i: usize| -> f64 {
-                    f[i * d..(i + 1) * d]
-                        .iter()
-                        .zip(&w)
-                        .map(|(a, b)| a * b)
-                        .sum()
-                };
-                let mut fitted: Vec<f64> = fit.iter().map(|&i| dot(i)).collect();
+                let row = |i: usize| &f[i * d..(i + 1) * d];
+                let mut fitted: Vec<f64> = fit.iter().map(|&i| dot(row(i), &w)).collect();
                 fitted.sort_by(f64::total_cmp);
                 w[0] -= fitted[fitted.len() / 2];
-                let dot = |i: usize| -> f64 {
-                    f[i * d..(i + 1) * d]
-                        .iter()
-                        .zip(&w)
-                        .map(|(a, b)| a * b)
-                        .sum()
-                };
                 for (i, l) in level.iter_mut().enumerate() {
-                    *l = dot(i).clamp(-5.0, 5.0).exp();
+                    *l = dot(row(i), &w).clamp(-5.0, 5.0).exp();
                 }
                 difficulty.push(w);
             }
@@ -315,14 +307,7 @@ impl Calibration {
         let f = features(window, c, prediction);
         self.difficulty
             .iter()
-            .map(|w| {
-                w.iter()
-                    .zip(&f)
-                    .map(|(a, b)| a * b)
-                    .sum::<f64>()
-                    .clamp(-5.0, 5.0)
-                    .exp()
-            })
+            .map(|w| dot(&f, w).clamp(-5.0, 5.0).exp())
             .collect()
     }
 }
