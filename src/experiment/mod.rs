@@ -10,6 +10,7 @@
 mod assessment;
 mod comparison;
 mod generalization;
+mod index;
 mod mismatch;
 mod paper;
 mod protocols;
@@ -26,8 +27,8 @@ use crate::learn::train::{EpochLog, Progress, TrainOptions, train};
 use crate::learn::uncertainty::calibrate;
 use crate::learn::windows::{DataRequest, DataSpec, prepare};
 use crate::plan::Plan;
-use crate::report::write_index;
 use crate::sensors::{Candidates, NoiseModel, PAPER_CHANNELS, SnrReference};
+pub use index::{VIEW_FOLDER, write_report};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -418,85 +419,6 @@ fn read_log(dir: &Path) -> Vec<EpochLog> {
                 .collect()
         })
         .unwrap_or_default()
-}
-
-/// Folder of an experiments report that holds a viewer page (`railforce demo` writes one).
-pub const VIEW_FOLDER: &str = "view";
-
-/// Rebuilds `index.html` of an experiments folder from every part present (each part's
-/// `section.json` and `meta.json`), whichever order and run they came from; the intro states
-/// the protocol of the latest run and warns when parts were computed on different data.
-pub fn write_report(out: &Path) -> Result<PathBuf> {
-    let read = |p: PathBuf| -> Option<serde_json::Value> {
-        crate::io::read_text(&p)
-            .ok()
-            .and_then(|t| serde_json::from_str(&t).ok())
-    };
-    let meta = read(out.join("meta.json")).unwrap_or_default();
-    let s = |k: &str| meta[k].as_str().unwrap_or("?").to_string();
-    let mut intro = vec![
-        format!(
-            "Latest run: railforce {}, plan {} ({} runs, data {}); noise: {}; split: {}; windows of {} steps, label {}.",
-            s("railforce_version"),
-            s("plan_name"),
-            meta["runs"].as_u64().unwrap_or(0),
-            s("data_fnv1a"),
-            s("noise_definition"),
-            s("split_description"),
-            meta["window"].as_u64().unwrap_or(0),
-            s("label_at").to_lowercase(),
-        ),
-        "Paper numbers come from another simulator and an unstated (apparently shuffled) split: a bar, not a target to match digit for digit. Each part below states its own protocol and the data it was computed on.".into(),
-    ];
-    let t = &meta["training"];
-    let count = |v: &serde_json::Value| v.as_u64().map_or("all".to_string(), |n| n.to_string());
-    if t.is_object() {
-        intro.push(format!(
-            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch ({} on one condition), validation on at most {} windows{}; classical models on at most {} windows.",
-            // lr is an f32: print its decimal, not its binary expansion.
-            t["lr"].as_f64().map_or("?".into(), |v| format!("{}", v as f32)),
-            t["batch"],
-            t["epochs"],
-            t["patience"],
-            count(&t["windows_per_epoch"]),
-            count(&meta["condition_windows_per_epoch"]),
-            count(&t["val_windows"]),
-            if meta["fresh_noise_every_epoch"].as_bool() == Some(true) {
-                "; networks trained at an SNR draw new input noise every epoch (validation and test keep one fixed, seeded realisation)"
-            } else {
-                "; networks trained on one fixed noise realisation"
-            },
-            t["classical_rows"],
-        ));
-    }
-    let mut data: Vec<(String, String)> = Vec::new();
-    for f in Which::FOLDERS {
-        if let Some(m) = read(out.join(f).join("meta.json")) {
-            data.push((
-                f.to_string(),
-                m["data_fnv1a"].as_str().unwrap_or("?").to_string(),
-            ));
-        }
-    }
-    if data.windows(2).any(|w| w[0].1 != w[1].1) {
-        intro.push(format!(
-            "Note: these parts were computed on different data: {}.",
-            data.iter()
-                .map(|(f, h)| format!("{f} {h}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
-    }
-    // After the parts, the viewer's folder where `railforce demo` wrote one.
-    let mut folders = Which::FOLDERS.to_vec();
-    folders.push(VIEW_FOLDER);
-    write_index(
-        out,
-        "railforce: wheel–rail force identification experiments",
-        &intro,
-        &folders,
-    )?;
-    Ok(out.join("index.html"))
 }
 
 /// Runs the experiments `which` (each expanded by [`Which::parts`], in order, without
