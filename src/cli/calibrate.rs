@@ -40,15 +40,14 @@ pub fn run(args: CalibrateArgs) -> Result<()> {
         .iter()
         .enumerate()
         .map(|(k, t)| {
-            let sp = cal.beta.get(k).copied().unwrap_or(0.0);
             format!(
                 "{t} ±{:.2} kN",
-                cal.half_width(k, 0.9, sp, 1.0) * model.meta.target_stats.std[k] * 1e-3
+                cal.typical_half_width(k, 0.9) * model.meta.target_stats.std[k] * 1e-3
             )
         })
         .collect();
     println!(
-        "calibrated on the {} ({} score{}); 90 % half-width of the median window: {}",
+        "calibrated on the {} ({} score{}); 90 % half-width of a typical window: {}",
         cal.part,
         cal.score.name(),
         if cal.difficulty.is_empty() {

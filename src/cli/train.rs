@@ -319,7 +319,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
     let model = train_with_bar(&ds, &spec, kind, &opts, args.ensemble, &args.out)?;
     if let Some(c) = &model.meta.calibration {
         println!(
-            "calibrated ({} score) on the {}; the 90 % half-width where the members agree as usual: {}",
+            "calibrated ({} score) on the {}; the 90 % half-width of a typical window: {}",
             c.score.name(),
             c.part,
             spec.targets
@@ -328,7 +328,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
                 .map(|(k, n)| format!(
                     "{} {:.2} kN",
                     short(n),
-                    c.half_width(k, 0.9, c.beta[k], 1.0) * model.meta.target_stats.std[k] * 1e-3
+                    c.typical_half_width(k, 0.9) * model.meta.target_stats.std[k] * 1e-3
                 ))
                 .collect::<Vec<_>>()
                 .join(", ")

@@ -297,6 +297,12 @@ impl Calibration {
         }
     }
 
+    /// Half-width of target `k`'s interval at `coverage` for a typical window: the median
+    /// difficulty, and an ensemble's members agreeing as usual (spread β); standardised units.
+    pub fn typical_half_width(&self, k: usize, coverage: f64) -> f64 {
+        self.half_width(k, coverage, self.beta.get(k).copied().unwrap_or(0.0), 1.0)
+    }
+
     /// Per target, the difficulty of a standardised window `[steps × c]` with the model's
     /// standardised `prediction` (1 where the calibration has none; the median calibration
     /// window's is 1).
