@@ -43,6 +43,7 @@ fn opts(out: &Path, format: Format, shard: Option<(usize, usize)>) -> GenerateOp
         shard,
         noise: Some(NoiseModel::new(6.0, SnrReference::Std)),
         settle: 0.2,
+        stepping: Default::default(),
     }
 }
 
@@ -107,6 +108,52 @@ fn generate_resume_shard_merge_and_formats() {
     assert_eq!(started(&ev), 0);
     assert_eq!(std::fs::read(&file).unwrap(), bytes);
     assert_eq!(dataset::data_identity(&a).unwrap(), identity);
+
+    // Another integrator is another data set: nothing resumes, the manifest says which, and
+    // the forces differ; a step outside (0, 1 ms] is refused before any run.
+    let li = dir.join("li");
+    let stepping = railforce::sim::Stepping {
+        integrator: railforce::sim::Integrator::LinearlyImplicit,
+        dt: 4e-4,
+    };
+    std::fs::create_dir_all(&li).unwrap();
+    for f in ["manifest.json", "tangent_v80_seed1.npz"] {
+        std::fs::copy(a.join(f), li.join(f)).unwrap();
+    }
+    let o = GenerateOptions {
+        stepping,
+        ..opts(&li, Format::Npz, None)
+    };
+    let (m_li, ev) = run_events(&plan, &o);
+    assert_eq!(started(&ev), 3, "another integrator resumes nothing");
+    assert_eq!(m_li["integration"]["dt_s"], 4e-4);
+    assert!(
+        m_li["integration"]["integrator"]
+            .as_str()
+            .unwrap()
+            .starts_with("linearly implicit")
+    );
+    let li_cols = npz::read_npz(&std::fs::read(li.join("tangent_v80_seed1.npz")).unwrap()).unwrap();
+    let q = |c: &[(String, Vec<f64>)]| {
+        c.iter()
+            .find(|(n, _)| n == "w1l_force_z")
+            .unwrap()
+            .1
+            .clone()
+    };
+    assert_ne!(q(&li_cols), q(&cols));
+    let bad = GenerateOptions {
+        stepping: railforce::sim::Stepping {
+            dt: 2e-3,
+            ..stepping
+        },
+        ..opts(&dir.join("bad"), Format::Npz, None)
+    };
+    let e = dataset::generate(&plan, &bad, &|_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("integration step") && e.contains("1 ms"), "{e}");
+    assert!(!dir.join("bad/manifest.json").exists());
 
     // Interruption: one file lost and the manifest written before it finished.
     let manifest_path = a.join("manifest.json");

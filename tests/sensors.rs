@@ -37,7 +37,7 @@ const DEFLECTIONS: [&str; 8] = [
 ];
 
 #[test]
-fn deflection_channels_exist_and_read_zero_in_the_static_loaded_position() {
+fn deflection_channels_exist_and_read_the_static_compression_at_rest() {
     let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
     let track = Track::new(
         TrackSpec::load(&root().join("tracks/tangent.toml")).unwrap(),
@@ -64,8 +64,27 @@ fn deflection_channels_exist_and_read_zero_in_the_static_loaded_position() {
             .position(|c| c == n)
             .unwrap_or_else(|| panic!("no {n}"));
         assert!(row[i].is_finite());
-        assert!(row[i].abs() < 1e-9, "{n} reads {} m at rest", row[i]);
     }
+    // Gauges read from the free element: in the static loaded position, each reads its
+    // element's static compression on its axis (vertical: load / stiffness, > 0 for the
+    // supports that carry load; the other axes 0).
+    let mut vertical = 0;
+    for e in &v.elements {
+        for (n, axis) in e.gauges(&v.bodies) {
+            let i = names.iter().position(|c| *c == n).unwrap();
+            let want = e.static_deflection()[axis];
+            assert!(
+                (row[i] - want).abs() < 1e-9,
+                "{n} reads {} m at rest, not {want} m",
+                row[i]
+            );
+            if axis == 2 {
+                assert!(want > 0.0, "{n}: a support carries load");
+                vertical += 1;
+            }
+        }
+    }
+    assert_eq!(vertical, 4 + 8 + 4 + 2);
     let cands = Candidates::Onboard.among(&names, &labels);
     assert!(cands.len() > 100, "{}", cands.len());
     assert!(
@@ -98,6 +117,7 @@ fn the_label_wheel_of_the_vehicle_file_reaches_the_labels() {
         shard: None,
         noise: Some(NoiseModel::new(6.0, SnrReference::Std)),
         settle: 0.1,
+        stepping: Default::default(),
     };
     let m = dataset::generate(&plan, &opts, &|_| {}).unwrap();
     assert_eq!(m.labels()[0], "w2r_force_y");
@@ -247,6 +267,7 @@ fn a_model_trained_at_6_db_is_validated_on_noisy_inputs() {
         shard: None,
         noise: Some(noise),
         settle: 0.1,
+        stepping: Default::default(),
     };
     dataset::generate(&plan, &opts, &|_| {}).unwrap();
     let ds = DataSet::load(&dir.join("data")).unwrap();

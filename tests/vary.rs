@@ -29,10 +29,8 @@ fn plan_with(vary: &str, name: &str) -> railforce::error::Result<Plan> {
     Plan::load(&path).and_then(|p| p.check_vary().map(|_| p))
 }
 
-/// A heavier carbody raises every wheel's static load by its share: +10 t over 8 wheels is
-/// +12.26 kN per wheel, within 0.5 %.
-#[test]
-fn a_heavier_draw_raises_the_static_wheel_load_by_its_share() {
+/// The C80 as its file gives it, and the same wagon drawn 10 t heavier in the carbody.
+fn nominal_and_heavier() -> (railforce::vehicle::Vehicle, railforce::vehicle::Vehicle) {
     let file = root().join("vehicles/c80.toml");
     let base = railforce::vehicle::Vehicle::load(&file).unwrap();
     let carbody = base
@@ -50,6 +48,14 @@ fn a_heavier_draw_raises_the_static_wheel_load_by_its_share() {
         },
     );
     let heavy = vehicle_for(&file, &draws).unwrap();
+    (base, heavy)
+}
+
+/// A heavier carbody raises every wheel's static load by its share: +10 t over 8 wheels is
+/// +12.26 kN per wheel, within 0.5 %.
+#[test]
+fn a_heavier_draw_raises_the_static_wheel_load_by_its_share() {
+    let (base, heavy) = nominal_and_heavier();
     let q = |v: &railforce::vehicle::Vehicle| {
         let s = railforce::sim::checks::static_loads(v, 1.0).unwrap();
         s.loads.iter().sum::<f64>() / s.loads.len() as f64
@@ -57,6 +63,57 @@ fn a_heavier_draw_raises_the_static_wheel_load_by_its_share() {
     let rise = q(&heavy) - q(&base);
     let want = 10_000.0 * railforce::GRAVITY / 8.0;
     assert!((rise / want - 1.0).abs() < 0.005, "{rise} N vs {want} N");
+}
+
+/// The displacement gauges read from each element's unloaded state, so they see the load: at
+/// rest a pad's vertical gauge reads its static compression, and +10 t on the carbody raises
+/// it by the pad's share over its stiffness, 12.26 kN / k_z, within 2 % (issue 36: a gauge
+/// zeroed on the loaded wagon could not tell a part-loaded one).
+#[test]
+fn a_heavier_draw_compresses_every_pad_gauge_by_its_share() {
+    use railforce::sim::{SimConfig, Simulation, checks::smooth_tangent};
+    use railforce::vehicle::Element;
+    let (base, heavy) = nominal_and_heavier();
+    let track = smooth_tangent(200.0);
+    // Each pad's (vertical gauge reading, stiffness) after 0.5 s at rest.
+    let pads = |v: &railforce::vehicle::Vehicle| -> Vec<(f64, f64, f64)> {
+        let cfg = SimConfig {
+            speed: 0.0,
+            duration: 0.5,
+            settle: 0.0,
+            ..SimConfig::default()
+        };
+        let mut sim = Simulation::new(v, &track, cfg).unwrap();
+        for _ in 0..(0.5 / sim.config().dt).round() as usize {
+            sim.step().unwrap();
+        }
+        sim.elements()
+            .iter()
+            .filter_map(|e| match e {
+                Element::ShearPad(p) => Some((
+                    e.deflection(sim.states()).unwrap().z,
+                    e.static_deflection().z,
+                    p.stiffness.z,
+                )),
+                _ => None,
+            })
+            .collect()
+    };
+    let (light, loaded) = (pads(&base), pads(&heavy));
+    assert_eq!(light.len(), 8);
+    let share = 10_000.0 * railforce::GRAVITY / 8.0;
+    for (&(a, a0, k), &(b, _, _)) in light.iter().zip(&loaded) {
+        assert!(
+            a0 > 0.0 && (a / a0 - 1.0).abs() < 0.02,
+            "at rest {a} m vs static {a0} m"
+        );
+        let want = share / k;
+        assert!(
+            ((b - a) / want - 1.0).abs() < 0.02,
+            "rise {} m vs {want} m",
+            b - a
+        );
+    }
 }
 
 /// The same condition and seed draw the same values; another seed or condition draws others;

@@ -39,6 +39,14 @@ pub struct GenerateArgs {
     /// Settling time of each run, s (not written).
     #[arg(long, default_value_t = 3.0)]
     settle: f64,
+    /// Integrator of every run: `semi-implicit` (the default) or `linearly-implicit` (the
+    /// wheel–rail damping and the rail masses implicit; see `railforce bench step`). Recorded in
+    /// the manifest; a data set resumes only with the same choice.
+    #[arg(long, default_value = "semi-implicit", value_parser = railforce::sim::Integrator::NAMES)]
+    integrator: String,
+    /// Integration step of every run, s.
+    #[arg(long, default_value_t = 2e-4)]
+    dt: f64,
     /// Join the shard manifests in --out into manifest.json instead of generating.
     #[arg(long)]
     merge: bool,
@@ -93,6 +101,11 @@ pub fn run(args: GenerateArgs) -> Result<()> {
             )),
         },
         settle: args.settle,
+        stepping: railforce::sim::Stepping {
+            integrator: railforce::sim::Integrator::parse(&args.integrator)
+                .expect("checked by clap"),
+            dt: args.dt,
+        },
     };
     let total = dataset::runs(&plan)
         .iter()

@@ -36,6 +36,11 @@ pub struct SimulateArgs {
     /// Integration step, s.
     #[arg(long, default_value_t = 2e-4)]
     dt: f64,
+    /// Integrator: `semi-implicit` (explicit in every force) or `linearly-implicit` (the
+    /// wheel–rail damping and the rail masses taken implicitly: accurate at larger steps,
+    /// `railforce bench step`).
+    #[arg(long, default_value = "semi-implicit", value_parser = railforce::sim::Integrator::NAMES)]
+    integrator: String,
     /// Report a derailment but keep running (default: stop with an error).
     #[arg(long)]
     keep_going: bool,
@@ -72,6 +77,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         duration: args.duration,
         settle: args.settle,
         dt: args.dt,
+        integrator: railforce::sim::Integrator::parse(&args.integrator).expect("checked by clap"),
         stop_on_derailment: !args.keep_going,
         ..SimConfig::default()
     };
@@ -85,6 +91,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         "duration_s": args.duration,
         "settle_s": args.settle,
         "integration_step_s": args.dt,
+        "integrator": args.integrator,
         "sampling_rate_hz": sim.config().output_rate,
         "anti_alias": format!("8th-order Butterworth low-pass at {} Hz at the integration rate, then decimation", sim.config().cutoff),
         "frame": "track frame: x along the running direction, y to the left, z up",

@@ -542,10 +542,10 @@ pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
                 .iter()
                 .map(|t| target_name(t, &ds.labels))
                 .collect();
-            let mut csv = String::from("condition,target,coverage,mean_width_kn\n");
+            let mut csv = String::from("condition,target,coverage,coverage_se,mean_width_kn\n");
             for r in &rows {
-                for (n, (c, w)) in names.iter().zip(&r.targets) {
-                    csv += &format!("{},{n},{c:.4},{w:.3}\n", r.condition);
+                for ((n, (c, w)), se) in names.iter().zip(&r.targets).zip(&r.se) {
+                    csv += &format!("{},{n},{c:.4},{se:.4},{w:.3}\n", r.condition);
                 }
             }
             let pooled = rows.last().expect("pooled row");
@@ -556,12 +556,17 @@ pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
                         .fold((1.0f64, 0.0f64), |a, r| {
                             (a.0.min(r.targets[k].0), a.1.max(r.targets[k].0))
                         });
+                    let per = &rows[..rows.len() - 1];
+                    let mut se: Vec<f64> = per.iter().map(|r| r.se[k]).collect();
+                    se.sort_by(f64::total_cmp);
                     format!(
-                        "{} {:.1} % pooled (conditions {:.1}–{:.1} %), mean width {:.2} kN",
+                        "{} {:.1} % pooled (conditions {:.1}–{:.1} %, each measured ± {:.1} % \
+                         (median batch-means se)), mean width {:.2} kN",
                         names[k],
                         pooled.targets[k].0 * 100.0,
                         lo * 100.0,
                         hi * 100.0,
+                        se.get(se.len() / 2).copied().unwrap_or(0.0) * 100.0,
                         pooled.targets[k].1
                     )
                 })

@@ -97,6 +97,13 @@ pub struct PatchForce {
     pub force: [f64; 3],
     /// Contact frame.
     pub frame: ContactFrame,
+    /// Normal damping coefficient of the patch, N·s/m.
+    pub damping: f64,
+    /// Normal stiffness of the patch, linearised at its load, N/m.
+    pub stiffness: f64,
+    /// Rate at which wheel and rail approach along the normal, m/s (the rail surface's rise
+    /// under the moving wheel included).
+    pub approach_rate: f64,
 }
 
 /// Everything the rail does to one wheel.
@@ -266,6 +273,9 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
             creep,
             force: f,
             frame,
+            damping,
+            stiffness: k_n,
+            approach_rate: rate,
         });
     }
     if let [Some(a), Some(b)] = &patches

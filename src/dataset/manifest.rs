@@ -305,6 +305,13 @@ pub(super) fn run_key(
     if *dataset != DatasetOptions::default() {
         extra += &format!("|dataset={dataset:?}");
     }
+    if opts.stepping != crate::sim::Stepping::default() {
+        extra += &format!(
+            "|stepping={}@{}",
+            opts.stepping.integrator.name(),
+            opts.stepping.dt
+        );
+    }
     fnv1a(
         format!(
             "{}|{}|{}|{}|{}|{}|{:?}|{}|{}|{}{extra}",

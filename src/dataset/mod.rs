@@ -77,6 +77,8 @@ pub struct GenerateOptions {
     pub noise: Option<NoiseModel>,
     /// Settling time of each run, s.
     pub settle: f64,
+    /// Integrator and step of every run (default: the default run's).
+    pub stepping: crate::sim::Stepping,
 }
 
 /// One run of a plan.
@@ -169,6 +171,12 @@ pub fn generate(
     opts: &GenerateOptions,
     events: &(dyn Fn(Event) + Sync),
 ) -> Result<Manifest> {
+    let dt = opts.stepping.dt;
+    if !(dt > 0.0 && dt <= 1e-3) {
+        return Err(Error::Domain(format!(
+            "integration step {dt} s: it must be in (0, 1 ms]"
+        )));
+    }
     if let Some((i, n)) = opts.shard
         && !(n >= 1 && (1..=n).contains(&i))
     {
@@ -277,8 +285,17 @@ pub fn generate(
         v.contact.table(); // build once, before the threads
     }
     let integration = Integration {
-        integrator: "semi-implicit Euler, fixed step (src/sim/mod.rs)".into(),
-        dt_s: SimConfig::default().dt,
+        integrator: match opts.stepping.integrator {
+            crate::sim::Integrator::SemiImplicit => {
+                "semi-implicit Euler, fixed step (src/sim/mod.rs)".into()
+            }
+            crate::sim::Integrator::LinearlyImplicit => {
+                "linearly implicit: semi-implicit Euler with the wheel–rail damping at the step's \
+                 midpoint and the rail masses implicit, fixed step (src/sim/integrator.rs)"
+                    .into()
+            }
+        },
+        dt_s: opts.stepping.dt,
         settle_s: opts.settle,
         anti_alias: format!(
             "8th-order Butterworth low-pass at {} Hz at the integration rate, then decimated",
@@ -365,6 +382,8 @@ pub fn generate(
             duration: run.condition.duration,
             settle: opts.settle,
             start: run.condition.start_m,
+            dt: opts.stepping.dt,
+            integrator: opts.stepping.integrator,
             ..SimConfig::default()
         };
         let mut sim = Simulation::new(vehicle, &track, cfg)

@@ -87,6 +87,17 @@ impl Butterworth {
         }
     }
 
+    /// A bank of `channels` independent channels through this filter, stepped together
+    /// ([`FilterBank`]).
+    pub fn bank(&self, channels: usize) -> FilterBank {
+        FilterBank {
+            sections: self.sections.clone(),
+            s0: vec![0.0; self.sections.len() * channels],
+            s1: vec![0.0; self.sections.len() * channels],
+            channels,
+        }
+    }
+
     /// Zero-phase filtering of a whole record: forward, then backward (gain [`Self::gain`]
     /// squared, no phase, so peaks stay where they were). As scipy's `filtfilt`, the record
     /// is first extended at both ends by its odd reflection (`2·x₀ − x_k`), here over three
@@ -116,6 +127,57 @@ impl Butterworth {
             .collect();
         back.reverse();
         back[pad..pad + n].to_vec()
+    }
+}
+
+/// Many channels through one Butterworth filter, stepped section by section across the
+/// channels (the state laid out per section, then per channel) so the channels go through in
+/// vector lanes: the same operations in the same order per channel as [`Butterworth::step`],
+/// so the same numbers to the last bit.
+#[derive(Debug, Clone)]
+pub struct FilterBank {
+    sections: Vec<Biquad>,
+    s0: Vec<f64>,
+    s1: Vec<f64>,
+    channels: usize,
+}
+
+impl FilterBank {
+    /// Number of channels.
+    pub fn channels(&self) -> usize {
+        self.channels
+    }
+
+    /// Sets every channel to the state of having held its value in `x` for ever.
+    pub fn hold(&mut self, x: &[f64]) {
+        let n = self.channels;
+        for (c, &x) in x.iter().enumerate().take(n) {
+            for (j, sec) in self.sections.iter().enumerate() {
+                // DC gain of each section is 1: y = v = x.
+                self.s1[j * n + c] = sec.b[2] * x - sec.a[1] * x;
+                self.s0[j * n + c] = sec.b[1] * x - sec.a[0] * x + self.s1[j * n + c];
+            }
+        }
+    }
+
+    /// Filters one sample of every channel in place (`x` holds [`Self::channels`] values).
+    #[inline]
+    pub fn step(&mut self, x: &mut [f64]) {
+        let n = self.channels;
+        let x = &mut x[..n];
+        for (j, sec) in self.sections.iter().enumerate() {
+            let (s0, s1) = (
+                &mut self.s0[j * n..(j + 1) * n],
+                &mut self.s1[j * n..(j + 1) * n],
+            );
+            let ([b0, b1, b2], [a0, a1]) = (sec.b, sec.a);
+            for ((v, s0), s1) in x.iter_mut().zip(s0.iter_mut()).zip(s1.iter_mut()) {
+                let y = b0 * *v + *s0;
+                *s0 = b1 * *v - a0 * y + *s1;
+                *s1 = b2 * *v - a1 * y;
+                *v = y;
+            }
+        }
     }
 }
 

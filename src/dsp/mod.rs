@@ -5,7 +5,7 @@ mod spectrum;
 mod stats;
 pub mod welch;
 
-pub use butterworth::Butterworth;
+pub use butterworth::{Butterworth, FilterBank};
 pub use spectrum::amplitude_spectrum;
 pub use stats::percentile;
 pub use welch::{WelchPsd, welch_psd};

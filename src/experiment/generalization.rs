@@ -89,6 +89,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         "FQ covered %",
         "FL width kN",
         "FQ width kN",
+        "FL covered se %",
+        "FQ covered se %",
     ]);
     let per = ev.per_condition(&model.meta.target_stats);
     // The 90 % interval's coverage and mean width per condition (split conformal on the
@@ -101,8 +103,10 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 format!("{:.1}", 100.0 * r.targets[1].0),
                 format!("{:.2}", r.targets[0].1),
                 format!("{:.2}", r.targets[1].1),
+                format!("{:.1}", 100.0 * r.se[0]),
+                format!("{:.1}", 100.0 * r.se[1]),
             ],
-            None => vec![MISSING.into(); 4],
+            None => vec![MISSING.into(); 6],
         }
     };
     let mut bars = [Vec::new(), Vec::new(), Vec::new()];

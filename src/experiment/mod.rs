@@ -375,6 +375,7 @@ fn simulate(plan: &Plan, dir: &Path, jobs: usize) -> Result<()> {
         shard: None,
         noise: None,
         settle: 3.0,
+        stepping: Default::default(),
     };
     generate(plan, &gopts, &|_| {})?;
     Ok(())

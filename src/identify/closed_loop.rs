@@ -173,6 +173,7 @@ pub fn validate(
         shard: None,
         noise,
         settle: 3.0,
+        stepping: Default::default(),
     };
     generate(&plan, &opts, &|_| {})?;
     let ds = DataSet::load(work)?;

@@ -51,6 +51,30 @@ pub struct CoverageRow {
     pub condition: String,
     /// Per target: the fraction of true forces inside the interval, and its mean width in kN.
     pub targets: Vec<(f64, f64)>,
+    /// Per target: the standard error of that fraction by batch means over 1 s blocks of each
+    /// run (neighbouring windows overlap and share their errors, so the windows are far from
+    /// independent: the blocks are nearly so). What a coverage measured on these runs can
+    /// resolve.
+    pub se: Vec<f64>,
+}
+
+/// Standard error of the mean of `inside` (0/1 per window) by batch means: windows grouped in
+/// blocks (`block[i]`), se = sd(block means) / √blocks. Zero with fewer than two blocks.
+fn batch_means_se<K: Ord + Copy>(inside: &[bool], block: &[K]) -> f64 {
+    let mut sums: std::collections::BTreeMap<K, (f64, f64)> = Default::default();
+    for (&b, &x) in block.iter().zip(inside) {
+        let e = sums.entry(b).or_default();
+        e.0 += f64::from(u8::from(x));
+        e.1 += 1.0;
+    }
+    let means: Vec<f64> = sums.values().map(|(s, n)| s / n).collect();
+    let n = means.len() as f64;
+    if n < 2.0 {
+        return 0.0;
+    }
+    let m = means.iter().sum::<f64>() / n;
+    let var = means.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (var / n).sqrt()
 }
 
 /// Scores `model` on `ds`.
@@ -145,21 +169,34 @@ impl Evaluation {
                 .filter(|&i| pick(&self.rows[i].0))
                 .collect();
             let n = idx.len().max(1) as f64;
+            // 1 s blocks of each run (condition, seed, whole second).
+            let block: Vec<(&str, u64, i64)> = idx
+                .iter()
+                .map(|&i| {
+                    let r = &self.rows[i];
+                    (r.0.as_str(), r.1, r.2.floor() as i64)
+                })
+                .collect();
+            let inside = |k: usize| -> Vec<bool> {
+                idx.iter()
+                    .map(|&i| {
+                        let (y, p) = self.rows[i].3[k];
+                        (y - p).abs() <= hw[i][k]
+                    })
+                    .collect()
+            };
+            let (targets, se) = (0..o)
+                .map(|k| {
+                    let inside = inside(k);
+                    let covered = inside.iter().filter(|&&x| x).count() as f64;
+                    let width = idx.iter().map(|&i| 2.0 * hw[i][k]).sum::<f64>() / n;
+                    ((covered / n, width * 1e-3), batch_means_se(&inside, &block))
+                })
+                .unzip();
             CoverageRow {
                 condition: name,
-                targets: (0..o)
-                    .map(|k| {
-                        let inside = idx
-                            .iter()
-                            .filter(|&&i| {
-                                let (y, p) = self.rows[i].3[k];
-                                (y - p).abs() <= hw[i][k]
-                            })
-                            .count() as f64;
-                        let width = idx.iter().map(|&i| 2.0 * hw[i][k]).sum::<f64>() / n;
-                        (inside / n, width * 1e-3)
-                    })
-                    .collect(),
+                targets,
+                se,
             }
         };
         let mut rows: Vec<CoverageRow> = order
@@ -296,5 +333,18 @@ mod tests {
         // The tangent has the smallest spread, so the lowest R² for the same error.
         let worst = Evaluation::worst_condition(&per, 0).unwrap();
         assert_eq!(worst.0, "tangent");
+    }
+
+    /// Whole blocks in or out: the blocks are the samples. Nine of ten 1 s blocks covered,
+    /// one not: sd of the block means √0.1, se √0.1/√10 = 0.1, however many windows a block
+    /// holds. Every block covered 90 % alike: no spread between blocks, se 0.
+    #[test]
+    fn batch_means_count_blocks_not_windows() {
+        let block: Vec<u32> = (0..10).flat_map(|b| [b; 200]).collect();
+        let whole: Vec<bool> = block.iter().map(|&b| b != 3).collect();
+        assert!((batch_means_se(&whole, &block) - 0.1).abs() < 1e-12);
+        let even: Vec<bool> = (0..2000).map(|i| i % 10 != 0).collect();
+        assert!(batch_means_se(&even, &block).abs() < 1e-12);
+        assert_eq!(batch_means_se(&even[..200], &block[..200]), 0.0);
     }
 }

@@ -92,6 +92,7 @@ fn kinked<'a>(
     track: &'a Track,
     speed: f64,
     duration: f64,
+    base: &SimConfig,
 ) -> Result<Simulation<'a>> {
     Simulation::new(
         vehicle,
@@ -102,7 +103,7 @@ fn kinked<'a>(
             settle: 0.0,
             initial_offset: 6e-3,
             stop_on_derailment: true,
-            ..SimConfig::default()
+            ..base.clone()
         },
     )
 }
@@ -149,7 +150,7 @@ fn coast(
     kick: Option<f64>,
 ) -> Result<CriticalSpeed> {
     let duration = hold + (from - to) / decel + 2.0;
-    let mut sim = kinked(vehicle, track, from, duration)?;
+    let mut sim = kinked(vehicle, track, from, duration, &SimConfig::default())?;
     let lead = 0;
     let steps_per_block = (1.0 / sim.config().dt).round() as usize;
     let mut blocks = Vec::new();
@@ -306,7 +307,19 @@ pub fn settled(
     duration: f64,
     tail: f64,
 ) -> Result<Settled> {
-    let mut sim = kinked(vehicle, track, speed, duration)?;
+    settled_with(vehicle, track, speed, duration, tail, &SimConfig::default())
+}
+
+/// [`settled`] with the step and integrator of `base`.
+pub fn settled_with(
+    vehicle: &Vehicle,
+    track: &Track,
+    speed: f64,
+    duration: f64,
+    tail: f64,
+    base: &SimConfig,
+) -> Result<Settled> {
+    let mut sim = kinked(vehicle, track, speed, duration, base)?;
     let heaviest = (0..vehicle.bodies.len())
         .max_by(|&a, &b| vehicle.bodies[a].mass.total_cmp(&vehicle.bodies[b].mass))
         .unwrap_or(0);
@@ -357,12 +370,20 @@ pub fn run(
     duration: f64,
     dt: f64,
 ) -> Result<Recording> {
-    let cfg = SimConfig {
-        speed,
-        duration,
-        dt,
-        ..SimConfig::default()
-    };
+    run_with(
+        vehicle,
+        track,
+        SimConfig {
+            speed,
+            duration,
+            dt,
+            ..SimConfig::default()
+        },
+    )
+}
+
+/// Records `vehicle` on `track` with the settings `cfg`.
+pub fn run_with(vehicle: &Vehicle, track: &Track, cfg: SimConfig) -> Result<Recording> {
     let mut sim = Simulation::new(vehicle, track, cfg)?;
     record(&mut sim, |_| {})
 }
@@ -391,6 +412,124 @@ pub fn yq_and_q(rec: &Recording, wheels: usize) -> Result<Vec<(f64, f64)>> {
             Ok((yq, sd))
         })
         .collect()
+}
+
+/// How one integration step compares with a finer one on the same run (issue 37's "same
+/// physics"): the largest relative difference over the wheels of each statistic.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepDifference {
+    /// Largest |rms(Y/Q) / rms(Y/Q)_ref − 1| over the wheels.
+    pub yq_rms: f64,
+    /// Largest |sd(Q) / sd(Q)_ref − 1| over the wheels.
+    pub q_sd: f64,
+    /// |sd(FL) / sd(FL)_ref − 1| of the label wheel's lateral force.
+    pub label_y_sd: f64,
+    /// Share of FL's and FQ's variance above 40 Hz at this step (the reference's beside it in
+    /// [`StepStudy::reference_high`]).
+    pub high: [f64; 2],
+}
+
+/// One step of a [`step_study`].
+#[derive(Debug, Clone)]
+pub struct StepTrial {
+    /// Integration step, s.
+    pub dt: f64,
+    /// Wall time of the run (settling included), s.
+    pub wall_s: f64,
+    /// Its differences from the reference, or why the run stopped (diverged, derailed).
+    pub outcome: std::result::Result<StepDifference, String>,
+}
+
+/// The same run at several steps against a finer reference step.
+#[derive(Debug, Clone)]
+pub struct StepStudy {
+    /// Reference step, s.
+    pub reference_dt: f64,
+    /// The reference's integrator.
+    pub reference_integrator: super::Integrator,
+    /// Its wall time, s.
+    pub reference_wall_s: f64,
+    /// Share of FL's and FQ's variance above 40 Hz at the reference step.
+    pub reference_high: [f64; 2],
+    /// The steps tried, in the order given.
+    pub trials: Vec<StepTrial>,
+}
+
+/// Runs `vehicle` on `track` at `speed` for `duration` s at the `reference` step (with its
+/// integrator) and at each of `steps` with `integrator`, and compares every wheel's Y/Q rms
+/// and Q standard deviation, the label wheel's lateral-force standard deviation and the labels'
+/// power above 40 Hz.
+pub fn step_study(
+    vehicle: &Vehicle,
+    track: &Track,
+    speed: f64,
+    duration: f64,
+    reference: (f64, super::Integrator),
+    steps: &[f64],
+    integrator: super::Integrator,
+) -> Result<StepStudy> {
+    let run = |dt, integrator| {
+        let cfg = SimConfig {
+            speed,
+            duration,
+            dt,
+            integrator,
+            ..SimConfig::default()
+        };
+        run_with(vehicle, track, cfg)
+    };
+    let n = vehicle.contact.wheelsets.len() * 2;
+    let label = vehicle.label_wheel_name().to_lowercase();
+    let (fl, fq) = (format!("w{label}_force_y"), format!("w{label}_force_z"));
+    let sd = |x: &[f64]| {
+        let m = x.iter().sum::<f64>() / x.len().max(1) as f64;
+        (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / x.len().max(1) as f64).sqrt()
+    };
+    let rate = SimConfig::default().output_rate;
+    let high = |rec: &Recording| -> Result<[f64; 2]> {
+        Ok([
+            power_above(&column(rec, &fl)?, rate, 40.0),
+            power_above(&column(rec, &fq)?, rate, 40.0),
+        ])
+    };
+    let t = std::time::Instant::now();
+    let base = run(reference.0, reference.1)?;
+    let reference_wall_s = t.elapsed().as_secs_f64();
+    let (base_stats, base_fl) = (yq_and_q(&base, n)?, sd(&column(&base, &fl)?));
+    let worst = |a: &[(f64, f64)], f: fn(&(f64, f64)) -> f64| {
+        a.iter()
+            .zip(&base_stats)
+            .map(|(x, y)| (f(x) / f(y) - 1.0).abs())
+            .fold(0.0f64, f64::max)
+    };
+    let mut trials = Vec::new();
+    for &dt in steps {
+        let t = std::time::Instant::now();
+        let outcome = match run(dt, integrator) {
+            Ok(rec) => {
+                let stats = yq_and_q(&rec, n)?;
+                Ok(StepDifference {
+                    yq_rms: worst(&stats, |p| p.0),
+                    q_sd: worst(&stats, |p| p.1),
+                    label_y_sd: (sd(&column(&rec, &fl)?) / base_fl - 1.0).abs(),
+                    high: high(&rec)?,
+                })
+            }
+            Err(e) => Err(e.to_string()),
+        };
+        trials.push(StepTrial {
+            dt,
+            wall_s: t.elapsed().as_secs_f64(),
+            outcome,
+        });
+    }
+    Ok(StepStudy {
+        reference_dt: reference.0,
+        reference_integrator: reference.1,
+        reference_wall_s,
+        reference_high: high(&base)?,
+        trials,
+    })
 }
 
 /// Attenuation of the default anti-alias filter at the output's Nyquist frequency, dB

@@ -3,12 +3,10 @@
 //! passes 40 Hz within 0.12 dB and stops the 100 Hz Nyquist frequency of the 200 Hz output by
 //! 48 dB (a 4th order at 60 Hz stopped it by only 18 dB).
 
-use crate::dsp::Butterworth;
+use crate::dsp::{Butterworth, FilterBank};
 
 /// Order of the filter.
 pub const ORDER: usize = 8;
-/// Filter state of one channel (two values per section).
-pub type FilterState = [f64; ORDER];
 
 /// The simulator's anti-alias filter.
 #[derive(Debug, Clone)]
@@ -25,17 +23,9 @@ impl Lowpass {
         self.0.gain(f)
     }
 
-    /// Filters one sample of a channel whose state is `state`.
-    #[inline]
-    pub fn step(&self, x: f64, state: &mut FilterState) -> f64 {
-        self.0.step(x, state)
-    }
-
-    /// Initial state of a channel that has held the value `x` for ever (no start transient).
-    pub fn steady_state(&self, x: f64) -> FilterState {
-        let mut st = [0.0; ORDER];
-        self.0.steady_state(x, &mut st);
-        st
+    /// `channels` channels through this filter, stepped together (the recorder's).
+    pub fn bank(&self, channels: usize) -> FilterBank {
+        self.0.bank(channels)
     }
 }
 

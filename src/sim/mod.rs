@@ -15,14 +15,17 @@
 pub mod checks;
 pub mod fidelity;
 mod filter;
+mod integrator;
 pub mod modes;
 pub mod output;
 pub mod profile;
 mod track_frame;
 mod wheel_rail;
 
+pub use integrator::{Integrator, Stepping};
 pub use output::{Recorder, RunSummary};
 pub use track_frame::{TrackFrame, project};
+use wheel_rail::RailCoupling;
 pub use wheel_rail::{RailState, WheelResult};
 
 use crate::error::{Error, Result};
@@ -65,6 +68,8 @@ pub struct SimConfig {
     /// Lateral offset of the whole vehicle at the start, m (a perturbation for stability and
     /// kinematic-oscillation checks).
     pub initial_offset: f64,
+    /// How the bodies are integrated ([`Integrator`]).
+    pub integrator: Integrator,
 }
 
 impl Default for SimConfig {
@@ -84,6 +89,7 @@ impl Default for SimConfig {
             lateral_limit: 39e-3,
             runaway_speed: 20.0,
             initial_offset: 0.0,
+            integrator: Integrator::SemiImplicit,
         }
     }
 }
@@ -135,6 +141,12 @@ pub struct Simulation<'a> {
     pub accelerations: Vec<Vector3<f64>>,
     /// Where the steps' time goes, when profiling is on ([`Simulation::set_profiling`]).
     profile: Option<Box<StepProfile>>,
+    /// Per wheelset: the wheel–rail damping of the last contact evaluation, world axes, about
+    /// its centre ([`crate::contact::patch_damping`]; the linearly implicit step's).
+    contact_damping: Vec<nalgebra::Matrix6<f64>>,
+    /// Per wheel: the contact's damping and normal stiffness on the rail's lateral and
+    /// vertical motion, track axes (the linearly implicit step's).
+    rail_coupling: Vec<RailCoupling>,
 }
 
 impl<'a> Simulation<'a> {
@@ -280,6 +292,8 @@ impl<'a> Simulation<'a> {
                 n_wheels
             ],
             rail_force: vec![[0.0, -static_load]; n_wheels],
+            contact_damping: vec![nalgebra::Matrix6::zeros(); vehicle.contact.wheelsets.len()],
+            rail_coupling: vec![RailCoupling::default(); n_wheels],
             inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
             hauling_integral: 0.0,
@@ -385,22 +399,7 @@ impl<'a> Simulation<'a> {
         self.forces(true)?;
         timed!(self.profile, "rails", self.move_rails());
         let t0 = self.profile.is_some().then(std::time::Instant::now);
-        // Semi-implicit Euler: velocities first, positions with the new velocities.
-        for (i, (st, w)) in self.states.iter_mut().zip(&self.wrenches).enumerate() {
-            let b = &self.vehicle.bodies[i];
-            let acc = w.force / b.mass;
-            self.accelerations[i] = acc;
-            st.velocity += acc * dt;
-            st.position += st.velocity * dt;
-            let rot = st.rotation;
-            let wb = rot.inverse() * st.angular_velocity;
-            let tb = rot.inverse() * w.torque;
-            let iw = b.inertia.component_mul(&wb);
-            let dwb = (tb - wb.cross(&iw)).component_div(&b.inertia);
-            let wb = wb + dwb * dt;
-            st.angular_velocity = rot * wb;
-            st.rotation = rot * UnitQuaternion::from_scaled_axis(wb * dt);
-        }
+        self.integrate();
         if let (Some(t0), Some(p)) = (t0, self.profile.as_deref_mut()) {
             p.add("integration (11 bodies)", t0.elapsed());
             p.steps += 1;

@@ -46,8 +46,8 @@ const WHEEL_SIGNALS: [(&str, &str); 7] = [
 pub struct Recorder {
     names: Vec<String>,
     units: Vec<&'static str>,
-    lowpass: Lowpass,
-    filter_state: Vec<super::filter::FilterState>,
+    /// Every channel but time and position, filtered together.
+    filters: crate::dsp::FilterBank,
     every: usize,
     count: usize,
     row: Vec<f64>,
@@ -90,8 +90,7 @@ impl Recorder {
         Recorder {
             names,
             units,
-            lowpass: Lowpass::new(cfg.cutoff, 1.0 / cfg.dt),
-            filter_state: vec![[0.0; super::filter::ORDER]; n],
+            filters: Lowpass::new(cfg.cutoff, 1.0 / cfg.dt).bank(n - 2),
             every,
             count: 0,
             row: vec![0.0; n],
@@ -115,13 +114,10 @@ impl Recorder {
         sim.refresh_frames();
         let sim = &*sim;
         signals(sim, self.paper, &mut self.row);
-        let first = self.count == 0;
-        for i in 2..self.row.len() {
-            if first {
-                self.filter_state[i] = self.lowpass.steady_state(self.row[i]);
-            }
-            self.row[i] = self.lowpass.step(self.row[i], &mut self.filter_state[i]);
+        if self.count == 0 {
+            self.filters.hold(&self.row[2..]);
         }
+        self.filters.step(&mut self.row[2..]);
         let due = self.count.is_multiple_of(self.every);
         self.count += 1;
         due.then_some(&self.row[..])

@@ -53,6 +53,16 @@ pub struct RailState {
     pub vz: f64,
 }
 
+/// What the contact does to the rail's lateral and vertical motion under one wheel, linearised
+/// (track axes; the linearly implicit step's): damping, normal stiffness, and the growth rate
+/// of the wheel's elastic push on the rail at the present approach.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct RailCoupling {
+    pub damping: nalgebra::Matrix2<f64>,
+    pub stiffness: nalgebra::Matrix2<f64>,
+    pub approach: nalgebra::Vector2<f64>,
+}
+
 impl Simulation<'_> {
     /// What the last step gave the contact evaluation for each wheel (1L, 1R, 2L, …).
     pub fn contact_inputs(&self) -> &[WheelOnRail] {
@@ -106,9 +116,11 @@ impl Simulation<'_> {
         let v = self.vehicle;
         let cs = &v.contact;
         let model = cs.model();
+        let implicit = self.cfg.integrator == super::Integrator::LinearlyImplicit;
         for (w, &b) in cs.wheelsets.iter().enumerate() {
             let f = self.frames[b];
             let (inputs, y_centre) = self.wheels_on_rails(w);
+            let mut damping = nalgebra::Matrix6::zeros();
             for (k, wr) in inputs.into_iter().enumerate() {
                 let idx = 2 * w + k;
                 let out = super::profile::timed!(
@@ -117,6 +129,20 @@ impl Simulation<'_> {
                     evaluate(self.table, &model, &wr)
                 );
                 self.inputs[idx] = wr;
+                if implicit {
+                    let mut rail = RailCoupling::default();
+                    for p in out.patches.iter().flatten() {
+                        let d = crate::contact::patch_damping(p, &model, wr.speed);
+                        damping += d;
+                        // The rail moves under the wheel's relative velocity and approach:
+                        // its reaction has the same damping, and the patch's normal stiffness.
+                        rail.damping += d.fixed_view::<2, 2>(1, 1);
+                        let n = nalgebra::Vector2::new(p.frame.n[1], p.frame.n[2]);
+                        rail.stiffness += n * n.transpose() * p.stiffness;
+                        rail.approach += n * (p.stiffness * p.approach_rate);
+                    }
+                    self.rail_coupling[idx] = rail;
+                }
                 let force = f.axes * Vector3::from(out.force);
                 self.wrenches[b].force += force;
                 self.wrenches[b].torque += f.axes * Vector3::from(out.moment);
@@ -145,6 +171,18 @@ impl Simulation<'_> {
                     },
                 };
             }
+            if implicit {
+                // Track axes to world: blocks A·D·Aᵀ.
+                let a = f.axes;
+                let mut world = nalgebra::Matrix6::zeros();
+                for (r, c) in [(0, 0), (0, 3), (3, 0), (3, 3)] {
+                    let blk = damping.fixed_view::<3, 3>(r, c).into_owned();
+                    world
+                        .fixed_view_mut::<3, 3>(r, c)
+                        .copy_from(&(a * blk * a.transpose()));
+                }
+                self.contact_damping[w] = world;
+            }
         }
         Ok(())
     }
@@ -155,6 +193,35 @@ impl Simulation<'_> {
             return;
         };
         let dt = self.cfg.dt;
+        if self.cfg.integrator == super::Integrator::LinearlyImplicit {
+            // Implicit in the support and in the contact's stiffness and damping on the rail
+            // (the rail mass on the Hertz spring is the stiffest mode of a compliant track):
+            // (M + Δt·(C_c + C_s) + Δt²·(K_c + K_s))·Δv
+            //     = Δt·(R − Δt·k_n·ṙ·n − K_s·(x + Δt·v) − C_s·v).
+            use nalgebra::{Matrix2, Vector2};
+            let m = Matrix2::from_diagonal(&Vector2::new(sup.lateral.mass, sup.vertical.mass));
+            let ks = Matrix2::from_diagonal(&Vector2::new(
+                sup.lateral.stiffness,
+                sup.vertical.stiffness,
+            ));
+            let cs =
+                Matrix2::from_diagonal(&Vector2::new(sup.lateral.damping, sup.vertical.damping));
+            for ((r, f), c) in self
+                .rails
+                .iter_mut()
+                .zip(&self.rail_force)
+                .zip(&self.rail_coupling)
+            {
+                let (x, v) = (Vector2::new(r.y, r.z), Vector2::new(r.vy, r.vz));
+                let a = m + (c.damping + cs) * dt + (c.stiffness + ks) * (dt * dt);
+                let rhs = (Vector2::from(*f) - c.approach * dt - ks * (x + v * dt) - cs * v) * dt;
+                let dv = a.lu().solve(&rhs).unwrap_or_else(Vector2::zeros);
+                (r.vy, r.vz) = (v.x + dv.x, v.y + dv.y);
+                r.y += r.vy * dt;
+                r.z += r.vz * dt;
+            }
+            return;
+        }
         for (r, f) in self.rails.iter_mut().zip(&self.rail_force) {
             sup.lateral.step(&mut r.y, &mut r.vy, f[0], dt);
             sup.vertical.step(&mut r.z, &mut r.vz, f[1], dt);

@@ -3,6 +3,7 @@
 mod contact;
 mod learn;
 mod simulate;
+mod step;
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
@@ -64,7 +65,18 @@ enum What {
         /// Simulated seconds per measurement.
         #[arg(long, default_value_t = 20.0)]
         seconds: f64,
+        /// Integrator (`bench step` measures what each costs in accuracy).
+        #[arg(long, default_value = "semi-implicit", value_parser = railforce::sim::Integrator::NAMES)]
+        integrator: String,
+        /// Integration step, s (default: the default step).
+        #[arg(long)]
+        dt: Option<f64>,
     },
+    /// Accuracy and speed against the integration step: the same run (default R 400 m, FRA
+    /// class 5, 60 km/h, 15 s) at each step and at a finer reference step; every wheel's Y/Q
+    /// rms and Q standard deviation, the label wheel's FL standard deviation and the labels'
+    /// power above 40 Hz, and the wall time. A step that diverges or derails says so.
+    Step(step::StepArgs),
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
@@ -152,6 +164,8 @@ pub fn run(args: BenchArgs) -> Result<()> {
             track,
             speed_kmh,
             seconds,
+            integrator,
+            dt,
         } => {
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench simulate`");
@@ -161,13 +175,33 @@ pub fn run(args: BenchArgs) -> Result<()> {
             v.contact.table();
             let table_s = t0.elapsed().as_secs_f64();
             let tr = railforce::track::Track::load(&super::builtin::resolve(&track)?)?;
-            let b = simulate::run(&v, &tr, speed_kmh / 3.6, seconds)?;
+            let default = railforce::sim::SimConfig::default();
+            let base = railforce::sim::SimConfig {
+                integrator: railforce::sim::Integrator::parse(&integrator)
+                    .expect("checked by clap"),
+                dt: dt.unwrap_or(default.dt),
+                ..default.clone()
+            };
+            let b = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, &base)?;
             println!(
-                "simulation benchmark: {} on {}, {speed_kmh} km/h, {seconds} s, step {} ms, one thread",
+                "simulation benchmark: {} on {}, {speed_kmh} km/h, {seconds} s, {} step {} ms, one thread",
                 v.name,
                 tr.spec().name,
+                base.integrator.name(),
                 b.dt * 1e3
             );
+            if base.integrator != default.integrator || base.dt != default.dt {
+                let r = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, &default)?;
+                println!(
+                    "  against the default ({} at {} ms) in the same run: physics {:.2}× ({:.1}× real time), all channels {:.2}× ({:.1}× real time)",
+                    default.integrator.name(),
+                    default.dt * 1e3,
+                    b.real_time_factor / r.real_time_factor,
+                    r.real_time_factor,
+                    b.real_time_factor_recorded / r.real_time_factor_recorded,
+                    r.real_time_factor_recorded
+                );
+            }
             println!(
                 "  physics only:       {:>6.2} µs per step, {:>5.1}× real time",
                 b.step_us, b.real_time_factor
@@ -207,6 +241,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             }
             Ok(())
         }
+        What::Step(args) => step::run(&args),
         What::Contact {
             vehicle,
             iterations,

@@ -29,20 +29,26 @@ pub struct SimulateBench {
 }
 
 /// Runs `seconds` of simulated time twice (physics only, then with the recorder) at `speed` on
-/// `track`.
-pub fn run(vehicle: &Vehicle, track: &Track, speed: f64, seconds: f64) -> Result<SimulateBench> {
+/// `track`, with the step and integrator of `base`.
+pub fn run(
+    vehicle: &Vehicle,
+    track: &Track,
+    speed: f64,
+    seconds: f64,
+    base: &SimConfig,
+) -> Result<SimulateBench> {
     let cfg = SimConfig {
         speed,
         duration: seconds,
         settle: 0.0,
-        ..SimConfig::default()
+        ..base.clone()
     };
     let dt = cfg.dt;
     let cfg_profiled = |speed, duration| SimConfig {
         speed,
         duration,
         settle: 0.0,
-        ..SimConfig::default()
+        ..base.clone()
     };
     let steps = (seconds / dt).round() as usize;
     let mut sim = Simulation::new(vehicle, track, cfg.clone())?;

@@ -150,6 +150,9 @@ impl ForceElement for CentrePlate {
     fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
         Some((&self.upper, &self.lower, &self.rest))
     }
+    fn static_deflection(&self) -> Vector3<f64> {
+        super::static_compression(self.preload, self.stiffness.z)
+    }
     fn gauge_stem(&self, _: &str, lower: &str, _: &str) -> Option<String> {
         Some(format!("centreplate_{lower}"))
     }

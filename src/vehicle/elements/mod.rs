@@ -102,6 +102,12 @@ pub(crate) trait ForceElement: Sized {
         let (upper, lower, rest) = self.attachments()?;
         Some(Relative::new(upper, lower, rest, states).d)
     }
+    /// Its compression in the static loaded position, from its unloaded (free) state (upper
+    /// body's axes, `+z` compressing): what its gauge reads at rest, a gauge zeroed on the free
+    /// element. Zero for elements that carry no static load.
+    fn static_deflection(&self) -> Vector3<f64> {
+        Vector3::zeros()
+    }
     /// Stem of its gauge channels from its bodies' names and its side (`l`/`r`).
     fn gauge_stem(&self, _upper: &str, _lower: &str, _side: &str) -> Option<String> {
         None
@@ -141,13 +147,24 @@ macro_rules! define_element {
                 }
             }
 
-            /// Relative displacement across the element from its static loaded position, in the
+            /// Relative displacement across the element from its unloaded (free) state, in the
             /// upper body's axes (lower attachment relative to the upper: `+z` compresses a
             /// supporting element), for the kinds that carry a displacement gauge
-            /// (assets/docs/physics.md §5).
+            /// (assets/docs/physics.md §5): the motion from the static loaded position plus
+            /// the static compression the element's load puts in it. A gauge zeroed on the
+            /// free element reads it, so a heavier wagon reads more (one zeroed on the loaded
+            /// wagon could not see its load).
             pub fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
                 match self {
-                    $(Element::$variant(e) => e.deflection(states),)*
+                    $(Element::$variant(e) => e.deflection(states).map(|d| d + e.static_deflection()),)*
+                }
+            }
+
+            /// Its compression in the static loaded position from its unloaded state, m (upper
+            /// body's axes): what [`Element::deflection`] reads at rest.
+            pub fn static_deflection(&self) -> Vector3<f64> {
+                match self {
+                    $(Element::$variant(e) => e.static_deflection(),)*
                 }
             }
 
@@ -231,6 +248,12 @@ impl Element {
             .map(|&a| (format!("{stem}_{}", ["x", "y", "z"][a]), a))
             .collect()
     }
+}
+
+/// Static compression `load / k` along z of a linear supporting element, m; none when it has
+/// no stiffness to compress (a rigid or absent spring reads nothing).
+fn static_compression(load: f64, k: f64) -> Vector3<f64> {
+    Vector3::new(0.0, 0.0, if k > 0.0 { load / k } else { 0.0 })
 }
 
 /// Relative motion across a two-point element, in the upper body's axes.

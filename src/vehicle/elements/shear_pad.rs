@@ -175,6 +175,9 @@ impl ForceElement for ShearPad {
     fn deflection(&self, states: &[BodyState]) -> Option<Vector3<f64>> {
         Some(self.relative(states).d)
     }
+    fn static_deflection(&self) -> Vector3<f64> {
+        super::static_compression(self.preload, self.stiffness.z)
+    }
     fn gauge_stem(&self, upper: &str, lower: &str, _: &str) -> Option<String> {
         Some(format!("pad_{upper}_{lower}"))
     }

@@ -139,6 +139,9 @@ impl ForceElement for SideBearer {
     fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
         Some((&self.upper, &self.lower, &self.rest))
     }
+    fn static_deflection(&self) -> Vector3<f64> {
+        super::static_compression(self.preload, self.stiffness)
+    }
     fn gauge_stem(&self, _: &str, lower: &str, side: &str) -> Option<String> {
         Some(format!("sidebearer_{lower}_{side}"))
     }

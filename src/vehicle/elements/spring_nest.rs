@@ -193,6 +193,9 @@ impl ForceElement for SpringNest {
     fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
         Some((&self.upper, &self.lower, &self.rest))
     }
+    fn static_deflection(&self) -> Vector3<f64> {
+        Vector3::new(0.0, 0.0, self.static_compression)
+    }
     fn gauge_stem(&self, _: &str, lower: &str, _: &str) -> Option<String> {
         Some(format!("nest_{lower}"))
     }
