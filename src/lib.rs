@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod assess;
+pub mod builtin;
 pub mod contact;
 pub mod dataset;
 pub mod dsp;
@@ -20,6 +21,8 @@ pub mod identify;
 pub mod io;
 pub mod learn;
 pub mod plan;
+#[cfg(feature = "python")]
+mod python;
 pub mod report;
 pub mod sensors;
 pub mod sim;

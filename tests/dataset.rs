@@ -173,9 +173,10 @@ fn generate_resume_shard_merge_and_formats() {
         "same seed, same bytes"
     );
     assert_eq!(m2["runs"].as_array().unwrap().len(), 3);
-    // The redone run has a new wall time in the manifest but the same bytes: the data
-    // identity (what reports and models quote) is unchanged.
+    // The redone run has the same bytes, and so has the manifest (it holds no wall time):
+    // the data identity (what reports and models quote) is unchanged.
     assert_eq!(dataset::data_identity(&a).unwrap(), identity);
+    let manifest_a = std::fs::read(a.join("manifest.json")).unwrap();
 
     // Two shards and a merge give the same files and runs.
     let b = dir.join("b");
@@ -197,6 +198,11 @@ fn generate_resume_shard_merge_and_formats() {
             .collect::<Vec<_>>()
     };
     assert_eq!(strip(&merged), strip(&m2));
+    assert_eq!(
+        std::fs::read(b.join("manifest.json")).unwrap(),
+        manifest_a,
+        "shards and a merge write the manifest of one process, byte for byte"
+    );
     for r in m2["runs"].as_array().unwrap() {
         let f = r["file"].as_str().unwrap();
         assert_eq!(
@@ -462,13 +468,14 @@ fn float32_subset_keeps_values_to_float32_precision() {
 }
 
 /// The typed manifest reads every manifest the previous code wrote: today's format (written
-/// back byte for byte), the 2026-11-27 one without `integration`, and the first writer's of
+/// back byte for byte), the 2026-12-01 one with each run's wall time (read and dropped), the
+/// 2026-11-27 one without `integration`, and the first writer's of
 /// 2026-11-22 without the data-set options, the noise reference, the accelerometer setting,
 /// the label wheel and each run's vehicle, class and start.
 #[test]
 fn typed_manifest_reads_every_format() {
     let dir = root().join("tests/fixtures/manifests");
-    let today = dir.join("2026-12-01.json");
+    let today = dir.join("2026-12-02.json");
     let m = Manifest::read(&today).unwrap().unwrap();
     let integration = m.integration.as_ref().unwrap();
     assert_eq!(integration.dt_s, 2e-4);
@@ -488,6 +495,14 @@ fn typed_manifest_reads_every_format() {
         std::fs::read_to_string(&back).unwrap(),
         std::fs::read_to_string(&today).unwrap(),
         "the typed manifest writes the untyped writer's bytes"
+    );
+
+    let dec01 = Manifest::read(&dir.join("2026-12-01.json"))
+        .unwrap()
+        .unwrap();
+    assert_eq!(
+        dec01, m,
+        "the wall times of 2026-12-01 are read and dropped"
     );
 
     let nov27 = Manifest::read(&dir.join("2026-11-27.json"))
@@ -516,7 +531,7 @@ fn typed_manifest_reads_every_format() {
 #[test]
 fn unreadable_manifest_field_is_named() {
     let text =
-        std::fs::read_to_string(root().join("tests/fixtures/manifests/2026-12-01.json")).unwrap();
+        std::fs::read_to_string(root().join("tests/fixtures/manifests/2026-12-02.json")).unwrap();
     let tmp = temp("manifest_bad_field");
     for (from, to, field) in [
         ("\"snr_db\": 6.0", "\"snr_db\": \"six\"", "snr_db"),

@@ -529,7 +529,7 @@ fn an_unknown_noise_reference_in_a_manifest_is_refused() {
         .replace("curve_r400_v60_seed1.npz", "r.csv")
         .replace("curve_r400_v60_seed4.npz", "r.csv")
     };
-    let today = fixture("2026-12-01.json");
+    let today = fixture("2026-12-02.json");
     assert!(today.contains(r#""snr_reference": "std""#));
     std::fs::write(
         dir.join("manifest.json"),

@@ -212,6 +212,24 @@ pub struct Assessment {
     pub intervals: Vec<interval::RowInterval>,
 }
 
+/// Assesses a run given as named columns (a `simulate` or `generate` run, or `identify`'s
+/// output): with each statistic's interval where the columns carry identified forces' bounds
+/// (`w1l_force_y_lo_N` …, at `coverage`), else plainly. `source` names the data in messages.
+pub fn assess_columns(
+    source: &str,
+    cols: &[(String, Vec<f64>)],
+    spans: &[Span],
+    criteria: &Criteria,
+    q0_kn: f64,
+    coverage: f64,
+) -> Result<Assessment> {
+    let run = RunForces::from_columns(source, cols)?;
+    match interval::bands_from_columns(source, cols, &run)? {
+        Some(b) => interval::assess_with_bands(&run, &b, spans, criteria, q0_kn, coverage),
+        None => assess(&run, spans, criteria, q0_kn),
+    }
+}
+
 /// Samples per second of a time column (median step).
 fn rate(time: &[f64]) -> f64 {
     let steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();

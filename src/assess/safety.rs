@@ -30,6 +30,22 @@ pub struct Limits {
     pub lateral_alpha: f64,
 }
 
+impl Limits {
+    /// The limits of the criteria's `[chinese]` table with the static wheel load
+    /// `static_wheel_load_kn` (what `identify`, `validate identify` and `assess` judge by
+    /// unless told otherwise).
+    pub fn from_criteria(criteria: &crate::assess::Criteria, static_wheel_load_kn: f64) -> Self {
+        let c = &criteria.chinese;
+        Limits {
+            y_over_q: c.derailment,
+            unloading: c.unloading,
+            static_wheel_load_kn,
+            min_duration_s: c.min_duration_s,
+            lateral_alpha: c.lateral_alpha,
+        }
+    }
+}
+
 fn default_lateral_alpha() -> f64 {
     0.85
 }

@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use railforce::assess::{Criteria, RunForces, assess, interval, spans};
+use railforce::assess::{Criteria, assess_columns, spans};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
@@ -56,7 +56,6 @@ pub fn run(args: AssessArgs) -> Result<()> {
         }
     };
     let cols = railforce::dataset::read_table(&args.file)?;
-    let run = RunForces::from_columns(&args.file.display().to_string(), &cols)?;
     let track = match &args.track {
         Some(t) => Some(super::builtin::resolve(t)?),
         None => track_from_manifest(&args.file),
@@ -72,11 +71,14 @@ pub fn run(args: AssessArgs) -> Result<()> {
             Vec::new()
         }
     };
-    let bands = interval::bands_from_columns(&args.file.display().to_string(), &cols, &run)?;
-    let a = match &bands {
-        Some(b) => interval::assess_with_bands(&run, b, &sections, &criteria, q0, args.coverage)?,
-        None => assess(&run, &sections, &criteria, q0)?,
-    };
+    let a = assess_columns(
+        &args.file.display().to_string(),
+        &cols,
+        &sections,
+        &criteria,
+        q0,
+        args.coverage,
+    )?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .file

@@ -180,14 +180,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
         bail!("--load-kn, --speed-kmh and --mu must be positive");
     }
     let setup = match &vehicle {
-        Some(v) => QuasiStatic {
-            table: v.contact.table().clone(),
-            model: v.contact.model(),
-            mass: 0.5 * v.bodies[v.contact.wheelsets[0]].mass,
-            r0: v.contact.geometry.nominal_radius,
-            load: load_kn * 1e3,
-            flange_angle: v.contact.flange_angle,
-        },
+        Some(v) => v.quasi_static(load_kn * 1e3),
         None => {
             let law = CreepLaw::parse(&args.law)
                 .ok_or_else(|| anyhow::anyhow!("--law must be polach, fastsim or linear"))?;

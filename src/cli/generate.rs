@@ -1,6 +1,6 @@
 //! `railforce generate`: data sets per working condition.
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use railforce::dataset::{self, Event, Format, GenerateOptions};
@@ -69,18 +69,11 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     let format = Format::parse(&args.format).ok_or_else(|| {
         anyhow::anyhow!("--format must be npz, parquet or csv, got {}", args.format)
     })?;
-    let shard = match &args.shard {
-        None => None,
-        Some(s) => {
-            let parsed = s
-                .split_once('/')
-                .and_then(|(i, n)| i.parse::<usize>().ok().zip(n.parse::<usize>().ok()));
-            match parsed {
-                Some((i, n)) if n >= 1 && (1..=n).contains(&i) => Some((i, n)),
-                _ => bail!("--shard must be i/N with 1 ≤ i ≤ N, got {s}"),
-            }
-        }
-    };
+    let shard = args
+        .shard
+        .as_deref()
+        .map(|s| super::with_flags(dataset::parse_shard(s), "--shard"))
+        .transpose()?;
     let jobs = args.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism()
             .map(|p| p.get())

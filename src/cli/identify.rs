@@ -4,7 +4,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use railforce::identify::safety::{IndexReport, Limits, Monitor};
-use railforce::identify::{SensorRows, SensorTable, Streamer, check, identify_with_bands};
+use railforce::identify::{SensorRows, SensorTable, Streamer, check};
 use railforce::learn::model::Model;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -55,17 +55,16 @@ impl LimitArgs {
             Some(p) => railforce::assess::Criteria::load(&super::builtin::resolve(p)?)?,
             None => railforce::assess::Criteria::builtin(),
         };
-        let c = &criteria.chinese;
-        let min_ms = self.min_duration_ms.unwrap_or(c.min_duration_s * 1000.0);
+        let base = Limits::from_criteria(&criteria, static_wheel_load_kn);
+        let min_ms = self.min_duration_ms.unwrap_or(base.min_duration_s * 1000.0);
         if !(min_ms.is_finite() && min_ms >= 0.0) {
             bail!("--min-duration-ms {min_ms}: give a duration ≥ 0");
         }
         Ok(Limits {
-            y_over_q: self.limit_yq.unwrap_or(c.derailment),
-            unloading: self.limit_unloading.unwrap_or(c.unloading),
-            static_wheel_load_kn,
+            y_over_q: self.limit_yq.unwrap_or(base.y_over_q),
+            unloading: self.limit_unloading.unwrap_or(base.unloading),
             min_duration_s: min_ms / 1000.0,
-            lateral_alpha: c.lateral_alpha,
+            ..base
         })
     }
 }
@@ -132,42 +131,34 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
         }
     })?;
     let t0 = std::time::Instant::now();
-    let (id, bands) = identify_with_bands(&mut model, &input, Some(args.coverage));
+    let out = railforce::identify::output::run(&mut model, &input, &limits, args.coverage);
     let secs = t0.elapsed().as_secs_f64();
-    if bands.is_none() {
+    if out.bands.is_none() {
         eprintln!(
             "note: {} has no calibration (trained before 2026-12-02): no intervals; retrain to get them",
             args.model.display()
         );
     }
-    let position = input
-        .position
-        .as_ref()
-        .map(|p| railforce::identify::at_labels(&model, p));
-    let mut monitor = Monitor::new(&id.targets, &limits, false);
-    let ood = railforce::identify::out_of_distribution(&model, &input);
+    let id = &out.identified;
+    let names: Vec<&str> = out.index_names.iter().map(String::as_str).collect();
     let mut s = header(
         &id.targets,
-        position.is_some(),
-        bands.is_some(),
-        &monitor.columns(),
-        ood.is_some(),
+        out.position.is_some(),
+        out.bands.is_some(),
+        &names,
+        out.ood_counts.is_some(),
     );
     for (i, t) in id.time.iter().enumerate() {
-        let idx = monitor.push(*t, &id.values[i]);
         s += &row(
             *t,
-            position.as_ref().map(|p| p[i]),
+            out.position.as_ref().map(|p| p[i]),
             &id.values[i],
-            bands.as_ref().map(|b| b.bounds[i].as_slice()),
-            &idx,
-            ood.as_ref().map(|o| o.channels[i].len()),
+            out.bands.as_ref().map(|b| b.bounds[i].as_slice()),
+            &out.indices[i],
+            out.ood_counts.as_ref().map(|o| o[i]),
         );
     }
-    let spans = ood
-        .as_ref()
-        .map(|o| (o.share(), o.spans(&id.time, &model.meta.data.channels)));
-    let reports = monitor.finish();
+    let (spans, reports) = (&out.ood_spans, &out.reports);
     if args.out.as_os_str() == "-" {
         std::io::stdout().write_all(s.as_bytes())?;
     } else {

@@ -4,7 +4,7 @@ use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use railforce::dataset::{Format, write_run};
-use railforce::sim::{SimConfig, Simulation, output, wheel_name};
+use railforce::sim::{Simulation, output, wheel_name};
 use railforce::track::{Track, TrackSpec};
 use railforce::vehicle::Vehicle;
 use std::path::PathBuf;
@@ -47,15 +47,18 @@ pub struct SimulateArgs {
 }
 
 pub fn run(args: SimulateArgs) -> Result<()> {
-    if !(args.duration > 0.0 && args.duration.is_finite()) {
-        bail!("--duration must be positive, got {}", args.duration);
-    }
-    if !(args.speed_kmh > 0.0 && args.speed_kmh <= 200.0) {
-        bail!("--speed-kmh must lie in (0, 200], got {}", args.speed_kmh);
-    }
-    if args.settle.is_nan() || args.settle < 0.0 {
-        bail!("--settle must not be negative, got {}", args.settle);
-    }
+    let request = railforce::sim::RunRequest {
+        speed_kmh: args.speed_kmh,
+        duration: args.duration,
+        settle: args.settle,
+        stepping: railforce::sim::Stepping {
+            integrator: railforce::sim::Integrator::parse(&args.integrator)
+                .expect("checked by clap"),
+            dt: args.dt,
+        },
+        stop_on_derailment: !args.keep_going,
+    };
+    let cfg = super::with_flags(request.config(), "--speed-kmh, --duration, --settle, --dt")?;
     let format = args
         .out
         .extension()
@@ -72,15 +75,6 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     args.track = super::builtin::resolve(&args.track)?;
     let vehicle = Vehicle::load(&args.vehicle)?;
     let track = Track::new(TrackSpec::load(&args.track)?, args.seed);
-    let cfg = SimConfig {
-        speed: args.speed_kmh / 3.6,
-        duration: args.duration,
-        settle: args.settle,
-        dt: args.dt,
-        integrator: railforce::sim::Integrator::parse(&args.integrator).expect("checked by clap"),
-        stop_on_derailment: !args.keep_going,
-        ..SimConfig::default()
-    };
     let mut sim = Simulation::new(&vehicle, &track, cfg)?;
     let meta = serde_json::json!({
         "tool": format!("railforce {}", env!("CARGO_PKG_VERSION")),

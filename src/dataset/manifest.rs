@@ -115,10 +115,10 @@ pub struct RunEntry {
     /// Start position along the track, m.
     #[serde(default)]
     pub start_m: Option<f64>,
-    /// Rows written.
+    /// Rows written. (Manifests before 2026-12-02 also held each run's wall time, read and
+    /// dropped: a manifest holds only what shapes the data, so one plan gives one manifest's
+    /// bytes whether one process, shards or workers made it.)
     pub rows: usize,
-    /// Wall time of the run, s.
-    pub wall_time_s: f64,
     /// Largest |Y/Q| of each wheel, 1L … 4R.
     pub peak_y_over_q: Vec<f64>,
     /// What the plan's `[vary]` drew for this run, by key: a value, or `{"scale": factor}`
@@ -160,8 +160,9 @@ pub struct Manifest {
     /// `i/N` for a shard manifest.
     #[serde(default)]
     pub shard: Option<String>,
-    /// The shard manifests a merge joined.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// The shard manifests a merge joined (in memory only: a merged manifest is written with
+    /// the bytes of one process's; earlier merges wrote the list, read and dropped).
+    #[serde(skip)]
     pub merged_from: Option<Vec<String>>,
     /// Conventions.
     pub conventions: Conventions,

@@ -81,6 +81,22 @@ pub struct GenerateOptions {
     pub stepping: crate::sim::Stepping,
 }
 
+/// Parses a shard `i/N` (1-based, 1 ≤ i ≤ N), as `generate --shard` and Python take it.
+pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
+    let parsed = text.split_once('/').and_then(|(i, n)| {
+        i.trim()
+            .parse::<usize>()
+            .ok()
+            .zip(n.trim().parse::<usize>().ok())
+    });
+    match parsed {
+        Some((i, n)) if n >= 1 && (1..=n).contains(&i) => Ok((i, n)),
+        _ => Err(Error::Domain(format!(
+            "shard {text}: a shard is i/N with 1 ≤ i ≤ N, e.g. 2/4"
+        ))),
+    }
+}
+
 /// One run of a plan.
 #[derive(Debug, Clone)]
 pub struct RunSpec {
@@ -415,7 +431,6 @@ pub fn generate(
             class: run.condition.class,
             start_m: run.condition.start_m,
             rows: rec.rows.len(),
-            wall_time_s: rec.summary.wall,
             peak_y_over_q: rec.summary.peak_y_over_q,
             draws: crate::vary::to_json(draws),
         };

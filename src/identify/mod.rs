@@ -7,6 +7,7 @@
 pub mod channel_map;
 pub mod check_report;
 pub mod closed_loop;
+pub mod output;
 mod stream;
 /// The safety indices live in [`crate::assess::safety`] (assess judges any force series);
 /// re-exported here, where the streaming identification uses them.

@@ -169,6 +169,21 @@ impl WindowSet {
         WindowSet { x, ..self.clone() }
     }
 
+    /// Per run, the standardised inputs `[rows × channels]` row-major (shared, not copied).
+    pub fn inputs(&self) -> &Arc<Vec<Vec<f32>>> {
+        &self.x
+    }
+
+    /// Per run, the standardised targets `[rows × outputs]` row-major.
+    pub fn target_rows(&self) -> &Arc<Vec<Vec<f32>>> {
+        &self.y
+    }
+
+    /// Steps from a window's first step to its label.
+    pub fn label_offset(&self) -> usize {
+        self.label_offset
+    }
+
     /// Row (time step) of window `i`'s label in its run.
     pub fn label_row(&self, i: usize) -> (usize, usize) {
         let w = self.windows[i];
@@ -326,6 +341,16 @@ impl NoiseRefresher {
             })
             .collect();
         Ok(NoiseRefresher { clean, sigma })
+    }
+
+    /// Per run, the standardised clean inputs `[rows × channels]` the noise is added to.
+    pub fn clean(&self) -> &[Vec<f32>] {
+        &self.clean
+    }
+
+    /// Per run and channel, the σ of the fresh noise in standardised units.
+    pub fn sigma(&self) -> &[Vec<f32>] {
+        &self.sigma
     }
 
     /// A new noisy copy of the inputs, determined by `seed`.

@@ -19,11 +19,13 @@ mod integrator;
 pub mod modes;
 pub mod output;
 pub mod profile;
+mod request;
 mod track_frame;
 mod wheel_rail;
 
 pub use integrator::{Integrator, Stepping};
 pub use output::{Recorder, RunSummary};
+pub use request::RunRequest;
 pub use track_frame::{TrackFrame, project};
 use wheel_rail::RailCoupling;
 pub use wheel_rail::{RailState, WheelResult};

@@ -64,6 +64,23 @@ impl ContactSettings {
     }
 }
 
+impl Vehicle {
+    /// The quasi-static contact of this vehicle's first wheelset with `load` N on each wheel:
+    /// its profiles, contact table and contact settings, exactly what its runs compute
+    /// (`railforce contact --vehicle`).
+    pub fn quasi_static(&self, load: f64) -> crate::contact::QuasiStatic {
+        let c = &self.contact;
+        crate::contact::QuasiStatic {
+            table: c.table().clone(),
+            model: c.model(),
+            mass: 0.5 * self.bodies[c.wheelsets[0]].mass,
+            r0: c.geometry.nominal_radius,
+            load,
+            flange_angle: c.flange_angle,
+        }
+    }
+}
+
 /// Speed control that stands for the rest of the train.
 #[derive(Debug, Clone, Copy)]
 pub struct Hauling {
