@@ -163,7 +163,7 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
         std::io::stdout().write_all(s.as_bytes())?;
     } else {
         railforce::io::write_atomic(&args.out, |w| w.write_all(s.as_bytes()))?;
-        let sp = write_safety_json(&args.out, &reports, &limits, map.as_ref(), spans.as_ref())?;
+        let sp = write_safety_json(&args.out, reports, &limits, map.as_ref(), spans.as_ref())?;
         eprintln!(
             "identified {} estimates of {} from {} ({} channels: {}) in {:.3} s; wrote {} and {}",
             id.time.len(),
@@ -193,7 +193,7 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
             );
         }
     }
-    print_safety(&reports, &limits);
+    print_safety(reports, &limits);
     print_ood(spans.as_ref());
     Ok(())
 }

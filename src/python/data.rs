@@ -123,7 +123,9 @@ fn open_dataset(py: Python<'_>, path: PathBuf) -> PyResult<PyDataset> {
     })
 }
 
-/// The part, data spec and prepared windows a request names.
+/// The part, data spec and prepared windows a request names (the Python call's arguments as
+/// they come).
+#[allow(clippy::too_many_arguments)]
 fn part_windows(
     ds: &DataSet,
     split: &str,
