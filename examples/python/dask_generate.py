@@ -29,7 +29,7 @@ def main(argv=None) -> float:
     ap.add_argument("--plan", default="demo")
     ap.add_argument("--out", required=True)
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--shards", type=int, default=None, help="default: 4 per worker")
+    ap.add_argument("--shards", type=int, default=None, help="default: one per worker")
     ap.add_argument("--scheduler", default=None)
     ap.add_argument("--settle", type=float, default=3.0)
     ap.add_argument("--snr-db", type=float, default=None)
@@ -37,7 +37,7 @@ def main(argv=None) -> float:
 
     from dask.distributed import Client, LocalCluster
 
-    shards = args.shards or 4 * args.workers
+    shards = args.shards or args.workers
     t0 = time.perf_counter()
     if args.scheduler:
         client, cluster = Client(args.scheduler), None

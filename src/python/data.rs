@@ -4,19 +4,22 @@
 use super::py_err;
 use crate::dataset::{DataSet, Manifest};
 use crate::features::{LabelAt, NoiseProtocol, Part, Split};
-use crate::learn::windows::{DataRequest, DataSpec, NoiseRefresher, WindowSet, prepare};
+use crate::learn::windows::{DataRequest, DataSpec, NoiseRefresher, Prepared, WindowSet, prepare};
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// A data set written by `generate`, loaded into memory.
 #[pyclass(name = "Dataset", module = "railforce", frozen)]
 pub struct PyDataset {
     ds: Arc<DataSet>,
     manifest: String,
+    /// The windows last prepared (standardised views of every run, all three parts) and the
+    /// spec they answer: asking for another part of the same spec reuses them.
+    prepared: Mutex<Option<(DataSpec, Arc<Prepared>)>>,
 }
 
 #[pymethods]
@@ -120,6 +123,7 @@ fn open_dataset(py: Python<'_>, path: PathBuf) -> PyResult<PyDataset> {
         ds: Arc::new(ds),
         manifest: serde_json::to_string(&manifest)
             .map_err(|e| PyValueError::new_err(e.to_string()))?,
+        prepared: Mutex::new(None),
     })
 }
 
@@ -127,7 +131,7 @@ fn open_dataset(py: Python<'_>, path: PathBuf) -> PyResult<PyDataset> {
 /// they come).
 #[allow(clippy::too_many_arguments)]
 fn part_windows(
-    ds: &DataSet,
+    dataset: &PyDataset,
     split: &str,
     channels: Option<Vec<String>>,
     window: usize,
@@ -135,7 +139,8 @@ fn part_windows(
     targets: &str,
     stride: usize,
     noise: Option<&str>,
-) -> PyResult<(Part, DataSpec, crate::learn::windows::Prepared)> {
+) -> PyResult<(Part, DataSpec, Arc<Prepared>)> {
+    let ds = &dataset.ds;
     let part = match split {
         "train" => Part::Train,
         "val" | "validation" => Part::Val,
@@ -179,11 +184,18 @@ fn part_windows(
         noise,
     };
     let spec = DataSpec::resolve(&req, ds).map_err(py_err)?;
-    let prepared = prepare(ds, &spec, None).map_err(py_err)?;
+    let mut cache = dataset.prepared.lock().expect("windows cache lock");
+    if let Some((cached, p)) = cache.as_ref()
+        && *cached == spec
+    {
+        return Ok((part, spec, p.clone()));
+    }
+    let prepared = Arc::new(prepare(ds, &spec, None).map_err(py_err)?);
+    *cache = Some((spec.clone(), prepared.clone()));
     Ok((part, spec, prepared))
 }
 
-fn part_of(p: &crate::learn::windows::Prepared, part: Part) -> &WindowSet {
+fn part_of(p: &Prepared, part: Part) -> &WindowSet {
     match part {
         Part::Train => &p.train,
         Part::Val => &p.val,
@@ -195,7 +207,7 @@ fn part_of(p: &crate::learn::windows::Prepared, part: Part) -> &WindowSet {
 fn describe<'py>(
     py: Python<'py>,
     spec: &DataSpec,
-    p: &crate::learn::windows::Prepared,
+    p: &Prepared,
     set: &WindowSet,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -242,9 +254,11 @@ fn windows<'py>(
     stride: usize,
     noise: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let ds = dataset.ds.clone();
-    let (part, spec, p) =
-        py.detach(|| part_windows(&ds, split, channels, window, label, targets, stride, noise))?;
+    let (part, spec, p) = py.detach(|| {
+        part_windows(
+            dataset, split, channels, window, label, targets, stride, noise,
+        )
+    })?;
     let set = part_of(&p, part);
     let (x, y) = py.detach(|| set.all());
     let (n, w, c, o) = (set.len(), set.window, set.channels, set.outputs);
@@ -273,8 +287,11 @@ fn window_source<'py>(
     noise: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let ds = dataset.ds.clone();
-    let (part, spec, p) =
-        py.detach(|| part_windows(&ds, split, channels, window, label, targets, stride, noise))?;
+    let (part, spec, p) = py.detach(|| {
+        part_windows(
+            dataset, split, channels, window, label, targets, stride, noise,
+        )
+    })?;
     let set = part_of(&p, part);
     // Training under the matched protocol draws fresh noise on the clean inputs per epoch.
     let fresh = part == Part::Train && spec.noise == NoiseProtocol::Matched;
