@@ -174,10 +174,14 @@ def windows(
     ``centre`` (the paper's) or ``last`` (causal); ``noise`` is the protocol (``matched`` when
     the data set has noisy copies, else ``clean``).
     """
+    return _windows(dataset, split, channels, window, label, targets, stride, noise, False)
+
+
+def _windows(dataset, split, channels, window, label, targets, stride, noise, source):
     ds = dataset if isinstance(dataset, Dataset) else open_dataset(dataset)
     return _native.windows(
         ds, split, None if channels is None else list(channels), int(window), label, targets,
-        int(stride), noise,
+        int(stride), noise, bool(source),
     )
 
 

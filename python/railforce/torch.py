@@ -22,7 +22,7 @@ from typing import Iterator, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import _native, open_dataset
+from . import _windows
 
 try:  # pragma: no cover - depends on the environment
     import torch as _torch
@@ -63,11 +63,7 @@ class WindowDataset(_Base):  # type: ignore[misc, valid-type]
         noise: Optional[str] = None,
         seed: int = 0,
     ) -> None:
-        ds = dataset if isinstance(dataset, _native.Dataset) else open_dataset(dataset)
-        src = _native.window_source(
-            ds, split, None if channels is None else list(channels), int(window), label,
-            targets, int(stride), noise,
-        )
+        src = _windows(dataset, split, channels, window, label, targets, stride, noise, True)
         self.inputs = src["inputs"]  # per run, [rows, channels] float32
         self.target_rows = src["target_rows"]  # per run, [rows, targets] float32
         self.sigma = src["sigma"]  # [runs, channels] or None: no fresh noise

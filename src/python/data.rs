@@ -127,74 +127,6 @@ fn open_dataset(py: Python<'_>, path: PathBuf) -> PyResult<PyDataset> {
     })
 }
 
-/// The part, data spec and prepared windows a request names (the Python call's arguments as
-/// they come).
-#[allow(clippy::too_many_arguments)]
-fn part_windows(
-    dataset: &PyDataset,
-    split: &str,
-    channels: Option<Vec<String>>,
-    window: usize,
-    label: &str,
-    targets: &str,
-    stride: usize,
-    noise: Option<&str>,
-) -> PyResult<(Part, DataSpec, Arc<Prepared>)> {
-    let ds = &dataset.ds;
-    let part = match split {
-        "train" => Part::Train,
-        "val" | "validation" => Part::Val,
-        "test" => Part::Test,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "split {split}: one of train, val, test"
-            )));
-        }
-    };
-    let label_at = match label {
-        "centre" | "center" => LabelAt::Centre,
-        "last" => LabelAt::Last,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "label {label}: centre (the paper's) or last (causal)"
-            )));
-        }
-    };
-    let noise = noise
-        .map(|n| {
-            NoiseProtocol::parse(n).ok_or_else(|| {
-                PyValueError::new_err(format!(
-                    "noise {n}: one of clean, matched, train-clean-test-noisy"
-                ))
-            })
-        })
-        .transpose()?;
-    let req = DataRequest {
-        channels: channels.unwrap_or_else(|| {
-            crate::sensors::PAPER_CHANNELS
-                .iter()
-                .map(|c| c.to_string())
-                .collect()
-        }),
-        targets: targets.to_string(),
-        window,
-        label_at,
-        stride,
-        split: Split::standard(ds),
-        noise,
-    };
-    let spec = DataSpec::resolve(&req, ds).map_err(py_err)?;
-    let mut cache = dataset.prepared.lock().expect("windows cache lock");
-    if let Some((cached, p)) = cache.as_ref()
-        && *cached == spec
-    {
-        return Ok((part, spec, p.clone()));
-    }
-    let prepared = Arc::new(prepare(ds, &spec, None).map_err(py_err)?);
-    *cache = Some((spec.clone(), prepared.clone()));
-    Ok((part, spec, prepared))
-}
-
 fn part_of(p: &Prepared, part: Part) -> &WindowSet {
     match part {
         Part::Train => &p.train,
@@ -238,10 +170,14 @@ fn describe<'py>(
     Ok(d)
 }
 
-/// The windows of one part as arrays: `x[n, window, channels]` and `y[n, targets]` (float32,
-/// standardised with the training part's statistics), with each window's run and first step.
+/// The windows of one part. Materialised (`source` false): `x[n, window, channels]` and
+/// `y[n, targets]` (float32, standardised with the training part's statistics), with each
+/// window's run and first step. As a source for a window dataset (`source` true): per run the
+/// part's standardised inputs `[rows, channels]` and targets `[rows, targets]`, and, for the
+/// matched protocol's training part, each run's noise σ per channel (standardised units) for a
+/// fresh draw every epoch, as the trainer makes it.
 #[pyfunction]
-#[pyo3(signature = (dataset, split, channels, window, label, targets, stride, noise))]
+#[pyo3(signature = (dataset, split, channels, window, label, targets, stride, noise, source))]
 #[allow(clippy::too_many_arguments)]
 fn windows<'py>(
     py: Python<'py>,
@@ -253,56 +189,95 @@ fn windows<'py>(
     targets: &str,
     stride: usize,
     noise: Option<&str>,
+    source: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (part, spec, p) = py.detach(|| {
-        part_windows(
-            dataset, split, channels, window, label, targets, stride, noise,
-        )
+    let (part, spec, p) = py.detach(|| -> PyResult<_> {
+        let ds = &dataset.ds;
+        let part = match split {
+            "train" => Part::Train,
+            "val" | "validation" => Part::Val,
+            "test" => Part::Test,
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "split {split}: one of train, val, test"
+                )));
+            }
+        };
+        let label_at = match label {
+            "centre" | "center" => LabelAt::Centre,
+            "last" => LabelAt::Last,
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "label {label}: centre (the paper's) or last (causal)"
+                )));
+            }
+        };
+        let noise = noise
+            .map(|n| {
+                NoiseProtocol::parse(n).ok_or_else(|| {
+                    PyValueError::new_err(format!(
+                        "noise {n}: one of clean, matched, train-clean-test-noisy"
+                    ))
+                })
+            })
+            .transpose()?;
+        let req = DataRequest {
+            channels: channels.unwrap_or_else(|| {
+                crate::sensors::PAPER_CHANNELS
+                    .iter()
+                    .map(|c| c.to_string())
+                    .collect()
+            }),
+            targets: targets.to_string(),
+            window,
+            label_at,
+            stride,
+            split: Split::standard(ds),
+            noise,
+        };
+        let spec = DataSpec::resolve(&req, ds).map_err(py_err)?;
+        let mut cache = dataset.prepared.lock().expect("windows cache lock");
+        if let Some((cached, p)) = cache.as_ref()
+            && *cached == spec
+        {
+            return Ok((part, spec, p.clone()));
+        }
+        let prepared = Arc::new(prepare(ds, &spec, None).map_err(py_err)?);
+        *cache = Some((spec.clone(), prepared.clone()));
+        Ok((part, spec, prepared))
     })?;
     let set = part_of(&p, part);
+    let d = describe(py, &spec, &p, set)?;
+    if source {
+        return window_source(py, dataset, part, &spec, &p, set, d);
+    }
     let (x, y) = py.detach(|| set.all());
     let (n, w, c, o) = (set.len(), set.window, set.channels, set.outputs);
-    let d = describe(py, &spec, &p, set)?;
     d.set_item("x", x.into_pyarray(py).reshape([n, w, c])?)?;
     d.set_item("y", y.into_pyarray(py).reshape([n, o])?)?;
     Ok(d)
 }
 
-/// What a window dataset draws from: per run the part's standardised inputs `[rows, channels]`
-/// and targets `[rows, targets]`, the windows' runs and first steps, and, for the matched
-/// protocol's training part, each run's noise σ per channel (standardised units) for a fresh
-/// draw every epoch, as the trainer makes it.
-#[pyfunction]
-#[pyo3(signature = (dataset, split, channels, window, label, targets, stride, noise))]
-#[allow(clippy::too_many_arguments)]
+/// [`windows`]' source form: `d` with the per-run inputs, targets and noise σ added.
 fn window_source<'py>(
     py: Python<'py>,
     dataset: &PyDataset,
-    split: &str,
-    channels: Option<Vec<String>>,
-    window: usize,
-    label: &str,
-    targets: &str,
-    stride: usize,
-    noise: Option<&str>,
+    part: Part,
+    spec: &DataSpec,
+    p: &Prepared,
+    set: &WindowSet,
+    d: Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let ds = dataset.ds.clone();
-    let (part, spec, p) = py.detach(|| {
-        part_windows(
-            dataset, split, channels, window, label, targets, stride, noise,
-        )
-    })?;
-    let set = part_of(&p, part);
     // Training under the matched protocol draws fresh noise on the clean inputs per epoch.
     let fresh = part == Part::Train && spec.noise == NoiseProtocol::Matched;
     let refresher = match (fresh, spec.noise_model) {
         (true, Some(model)) => Some(
-            py.detach(|| NoiseRefresher::new(&ds, &spec, &p.input_stats, &model))
+            py.detach(|| NoiseRefresher::new(&ds, spec, &p.input_stats, &model))
                 .map_err(py_err)?,
         ),
         _ => None,
     };
-    let d = describe(py, &spec, &p, set)?;
     let c = set.channels;
     let o = set.outputs;
     let (inputs, sigma): (Vec<Vec<f32>>, Option<Vec<Vec<f32>>>) = match &refresher {
@@ -337,6 +312,5 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyDataset>()?;
     m.add_function(wrap_pyfunction!(open_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(windows, m)?)?;
-    m.add_function(wrap_pyfunction!(window_source, m)?)?;
     Ok(())
 }
