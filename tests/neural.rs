@@ -4,6 +4,7 @@ use railforce::learn::neural::{Architecture, NetConfig, Network};
 
 fn config(architecture: Architecture, channels: usize, outputs: usize, dropout: f32) -> NetConfig {
     NetConfig {
+        quantiles: None,
         architecture,
         window: 20,
         channels,

@@ -68,6 +68,11 @@ impl Stepper {
         match engine {
             GradientEngine::Fused => Ok(Stepper::Fused),
             #[cfg(feature = "burn")]
+            burn if config.quantiles.is_some() => Err(Error::Domain(format!(
+                "quantile heads train with the fused engine only, not {}",
+                burn.name()
+            ))),
+            #[cfg(feature = "burn")]
             burn => {
                 let device = burn_device(burn)?;
                 let net = super::burn::BurnNet::new(config, &device);
@@ -102,22 +107,60 @@ impl Stepper {
         match self {
             Stepper::Fused => {
                 net.params.zero_grad();
+                let (quantiles, heads) = (net.config.quantiles, net.config.outputs);
                 let pred = net.forward(x, n, true);
                 dout.clear();
-                let scale = 2.0 / y.len() as f32;
-                let mut l = 0.0f64;
-                for (p, t) in pred.iter().zip(y.iter()) {
-                    let e = p - t;
-                    l += (e * e) as f64;
-                    dout.push(scale * e);
-                }
+                let l = match quantiles {
+                    None => squared_error(pred, y, dout),
+                    Some(c) => with_quantiles(pred, y, heads / 3, c, dout),
+                };
                 net.backward(x, dout);
-                Ok(l / y.len() as f64)
+                Ok(l)
             }
             #[cfg(feature = "burn")]
             Stepper::Burn(module, device) => module.gradients(net, x, y, n, device),
         }
     }
+}
+
+/// Mean squared error of `pred` against `y` and its gradient into `dout`.
+fn squared_error(pred: &[f32], y: &[f32], dout: &mut Vec<f32>) -> f64 {
+    let scale = 2.0 / y.len() as f32;
+    let mut l = 0.0f64;
+    for (p, t) in pred.iter().zip(y) {
+        let e = p - t;
+        l += (e * e) as f64;
+        dout.push(scale * e);
+    }
+    l / y.len() as f64
+}
+
+/// The loss of a head with quantiles at coverage `c` (rows of `pred`: the `o` means, the `o`
+/// lower and the `o` upper quantiles; rows of `y`: the `o` targets): the means' squared error
+/// plus the pinball loss of each quantile (Koenker & Bassett 1978,
+/// `ρ_τ(e) = max(τ·e, (τ − 1)·e)` with `e = y − q`), averaged over the targets, and the
+/// gradient into `dout`. Returns the mean heads' squared error (what validation compares).
+fn with_quantiles(pred: &[f32], y: &[f32], o: usize, c: f64, dout: &mut Vec<f32>) -> f64 {
+    let n = y.len() / o;
+    let taus = [(1.0 - c as f32) / 2.0, (1.0 + c as f32) / 2.0];
+    let scale = 1.0 / y.len() as f32;
+    let mut l = 0.0f64;
+    dout.resize(pred.len(), 0.0);
+    for i in 0..n {
+        let (row, t) = (&pred[i * 3 * o..(i + 1) * 3 * o], &y[i * o..(i + 1) * o]);
+        let d = &mut dout[i * 3 * o..(i + 1) * 3 * o];
+        for k in 0..o {
+            let e = row[k] - t[k];
+            l += (e * e) as f64;
+            d[k] = 2.0 * scale * e;
+            for (h, tau) in taus.iter().enumerate() {
+                let q = row[(h + 1) * o + k];
+                // ∂ρ_τ(y − q)/∂q: −τ below the target, 1 − τ above it.
+                d[(h + 1) * o + k] = scale * if t[k] > q { -tau } else { 1.0 - tau };
+            }
+        }
+    }
+    l / y.len() as f64
 }
 
 /// The burn device (without autodiff) of a gradient engine: burn-flex on the CPU, or the best

@@ -122,6 +122,21 @@ fn is_one(n: &usize) -> bool {
     *n == 1
 }
 
+/// A quantile head's outputs (rows: `o` means, `o` lower, `o` upper quantiles at coverage
+/// `c`) as the mean and a spread: half the quantiles' distance over the normal quantile of
+/// `c`, i.e. the σ of a normal law with that central interval, so the spread means what an
+/// ensemble's does and one calibration serves both (`learn::uncertainty`).
+fn quantile_spread(all: &[f32], o: usize, c: f64) -> (Vec<f32>, Option<Vec<f32>>) {
+    let z = crate::features::normal_quantile(0.5 + c / 2.0) as f32;
+    let (mut mean, mut spread) = (Vec::new(), Vec::new());
+    for row in all.chunks_exact(3 * o) {
+        mean.extend_from_slice(&row[..o]);
+        // Crossed quantiles (lower above upper) give no width, never a negative one.
+        spread.extend((0..o).map(|k| (row[2 * o + k] - row[o + k]).max(0.0) / (2.0 * z)));
+    }
+    (mean, Some(spread))
+}
+
 /// The fitted function.
 pub enum Engine {
     /// A network.
@@ -156,6 +171,11 @@ impl Model {
             Engine::Net(net) => net.predict(x, n),
             Engine::Classical(c) => c.predict(x, n),
         };
+        if let Engine::Net(net) = &mut self.engine
+            && let Some(c) = net.config.quantiles
+        {
+            return quantile_spread(&net.predict_all(x, n), net.config.outputs / 3, c);
+        }
         let first = run(&mut self.engine);
         if self.members.is_empty() {
             return (first, None);

@@ -51,6 +51,10 @@ pub struct TrainOptions {
     /// What computes each minibatch's forward and backward pass (networks only).
     #[serde(default)]
     pub engine: GradientEngine,
+    /// Networks: quantile heads at this nominal coverage beside the mean (issue 36; the
+    /// intervals then follow the heads' width, `learn::uncertainty`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quantile_heads: Option<f64>,
 }
 
 impl Default for TrainOptions {
@@ -68,6 +72,7 @@ impl Default for TrainOptions {
             fresh_noise: None,
             val_windows: None,
             engine: GradientEngine::Fused,
+            quantile_heads: None,
         }
     }
 }
@@ -226,7 +231,8 @@ pub fn train(
                 architecture,
                 window: spec.window,
                 channels: spec.channels.len(),
-                outputs: spec.targets.len(),
+                outputs: spec.targets.len() * if opts.quantile_heads.is_some() { 3 } else { 1 },
+                quantiles: opts.quantile_heads,
                 dropout: opts.dropout,
                 seed: opts.seed,
             };

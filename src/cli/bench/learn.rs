@@ -52,6 +52,7 @@ pub fn gemm_gflops() -> f64 {
 
 fn bench_config(architecture: Architecture) -> NetConfig {
     NetConfig {
+        quantiles: None,
         architecture,
         window: 20,
         channels: 21,
@@ -225,6 +226,7 @@ pub fn streaming_latency_us(samples: usize) -> f64 {
         .map(|c| c.to_string())
         .collect();
     let config = NetConfig {
+        quantiles: None,
         architecture: Architecture::CnnBiLstm,
         window: 20,
         channels: 21,

@@ -50,8 +50,13 @@ pub struct NetConfig {
     pub window: usize,
     /// Input channels.
     pub channels: usize,
-    /// Outputs (1 for FL or FQ, 2 for both).
+    /// Outputs of the head (1 for FL or FQ, 2 for both; three times that with quantile heads).
     pub outputs: usize,
+    /// Quantile heads (issue 36): with `Some(c)`, the head gives per target its mean, then its
+    /// `(1 − c)/2` and `(1 + c)/2` quantiles (`outputs` is three times the targets, in that
+    /// order), trained with the pinball loss beside the mean's squared error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quantiles: Option<f64>,
     /// Dropout probability of the head.
     pub dropout: f32,
     /// Seed of the initial weights and of dropout.
@@ -405,8 +410,22 @@ impl Network {
         debug_assert_eq!(x.len(), rows * c);
     }
 
-    /// Predictions for `x[B, window, channels]` in evaluation mode, in chunks of 1024 windows.
+    /// The targets' estimates for `x[B, window, channels]` in evaluation mode, `[B, targets]`
+    /// (the mean heads of a network with quantile heads).
     pub fn predict(&mut self, x: &[f32], batch: usize) -> Vec<f32> {
+        let all = self.predict_all(x, batch);
+        if self.config.quantiles.is_none() {
+            return all;
+        }
+        let o = self.config.outputs / 3;
+        all.chunks_exact(3 * o)
+            .flat_map(|row| row[..o].iter().copied())
+            .collect()
+    }
+
+    /// Every head's output for `x[B, window, channels]` in evaluation mode, `[B, outputs]`, in
+    /// chunks of 1024 windows.
+    pub fn predict_all(&mut self, x: &[f32], batch: usize) -> Vec<f32> {
         let per = self.config.window * self.config.channels;
         let mut out = Vec::with_capacity(batch * self.config.outputs);
         for chunk in x.chunks(per * 1024) {
