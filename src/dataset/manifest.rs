@@ -398,6 +398,22 @@ pub fn run_entry(run_file: &Path) -> Option<(Manifest, RunEntry)> {
     Some((m, entry))
 }
 
+/// Parses a shard `i/N` (1-based, 1 ≤ i ≤ N), as `generate --shard` and Python take it.
+pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
+    let parsed = text.split_once('/').and_then(|(i, n)| {
+        i.trim()
+            .parse::<usize>()
+            .ok()
+            .zip(n.trim().parse::<usize>().ok())
+    });
+    match parsed {
+        Some((i, n)) if n >= 1 && (1..=n).contains(&i) => Ok((i, n)),
+        _ => Err(Error::Domain(format!(
+            "shard {text}: a shard is i/N with 1 ≤ i ≤ N, e.g. 2/4"
+        ))),
+    }
+}
+
 /// Joins the shard manifests in `out` into `manifest.json` (runs sorted by condition and seed).
 pub fn merge(out: &Path) -> Result<Manifest> {
     let mut shards: Vec<PathBuf> = std::fs::read_dir(out)

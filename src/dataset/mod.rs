@@ -13,7 +13,7 @@ mod table;
 pub use data_set::{DataSet, Run};
 pub use manifest::{
     ChannelEntry, Conventions, FileRef, Integration, Labels, Manifest, RunEntry, data_identity,
-    file_hash, fnv1a, manifest_path, merge, run_entry,
+    file_hash, fnv1a, manifest_path, merge, parse_shard, run_entry,
 };
 use manifest::{refuse_mixing, run_key};
 pub use table::{not_a_number, read_csv, read_table, row_length};
@@ -79,22 +79,6 @@ pub struct GenerateOptions {
     pub settle: f64,
     /// Integrator and step of every run (default: the default run's).
     pub stepping: crate::sim::Stepping,
-}
-
-/// Parses a shard `i/N` (1-based, 1 ≤ i ≤ N), as `generate --shard` and Python take it.
-pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
-    let parsed = text.split_once('/').and_then(|(i, n)| {
-        i.trim()
-            .parse::<usize>()
-            .ok()
-            .zip(n.trim().parse::<usize>().ok())
-    });
-    match parsed {
-        Some((i, n)) if n >= 1 && (1..=n).contains(&i) => Ok((i, n)),
-        _ => Err(Error::Domain(format!(
-            "shard {text}: a shard is i/N with 1 ≤ i ≤ N, e.g. 2/4"
-        ))),
-    }
 }
 
 /// One run of a plan.
