@@ -74,11 +74,7 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         .as_deref()
         .map(|s| super::with_flags(dataset::parse_shard(s), "--shard"))
         .transpose()?;
-    let jobs = args.jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|p| p.get())
-            .unwrap_or(1)
-    });
+    let jobs = args.jobs.unwrap_or_else(dataset::default_jobs);
     let opts = GenerateOptions {
         out: args.out.clone(),
         format,

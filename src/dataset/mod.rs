@@ -81,6 +81,13 @@ pub struct GenerateOptions {
     pub stepping: crate::sim::Stepping,
 }
 
+/// Runs in parallel when a user names no number: one per core.
+pub fn default_jobs() -> usize {
+    std::thread::available_parallelism()
+        .map(|p| p.get())
+        .unwrap_or(1)
+}
+
 /// One run of a plan.
 #[derive(Debug, Clone)]
 pub struct RunSpec {

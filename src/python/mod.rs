@@ -170,11 +170,7 @@ fn generate(
     let opts = GenerateOptions {
         out,
         format,
-        jobs: jobs.unwrap_or_else(|| {
-            std::thread::available_parallelism()
-                .map(|p| p.get())
-                .unwrap_or(1)
-        }),
+        jobs: jobs.unwrap_or_else(dataset::default_jobs),
         shard,
         noise,
         settle: settle_s,
