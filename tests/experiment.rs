@@ -152,6 +152,8 @@ fn every_experiment_runs_end_to_end() {
         ),
         "{mismatch}"
     );
+    // Paper's 21 and on-board, nominal- and fleet-trained (the weighed-mass model needs the
+    // experiments' data set to keep `vehicle_mass_t`: not yet, issue 36).
     assert_eq!(mismatch.lines().count(), 1 + 2 * 2 * 6, "{mismatch}");
     for case in [
         "half_payload",

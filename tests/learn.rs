@@ -481,18 +481,9 @@ fn quantile_heads_learn_where_the_noise_is_larger() {
     );
     let coverage = covered as f64 / prep.test.len() as f64;
     assert!((0.8..0.97).contains(&coverage), "raw coverage {coverage}");
-    // Quantile heads and an ensemble do not mix; a classical model has no heads.
-    let e = railforce::learn::uncertainty::train_ensemble(
-        &ds,
-        &spec,
-        ModelKind::Cnn,
-        &opts,
-        2,
-        &tmp("quantile_ensemble"),
-        &mut |_, _| {},
-    )
-    .err()
-    .unwrap()
-    .to_string();
-    assert!(e.contains("quantile heads or an ensemble"), "{e}");
+    // Heads are one network's: an ensemble's members, classical models and the burn engine
+    // train without them.
+    assert_eq!(opts.heads_for(ModelKind::Cnn, 1), Some(0.9));
+    assert_eq!(opts.heads_for(ModelKind::Cnn, 2), None);
+    assert_eq!(opts.heads_for(ModelKind::Gbdt, 1), None);
 }

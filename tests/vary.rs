@@ -116,6 +116,53 @@ fn a_heavier_draw_compresses_every_pad_gauge_by_its_share() {
     }
 }
 
+/// The weighed mass (`vehicle_mass_t`, issue 36) is recorded as the drawn wagon's total
+/// mass, 10 t more for the heavier draw, and no noise model ever touches it (a known number,
+/// not a sensor): the fleet's models may read the payload that no gauge can.
+#[test]
+fn the_weighed_mass_is_recorded_as_drawn_and_never_noised() {
+    use railforce::sensors::{NoiseModel, SnrReference, VEHICLE_MASS};
+    use railforce::sim::{Recorder, SimConfig, Simulation, checks::smooth_tangent};
+    let (base, heavy) = nominal_and_heavier();
+    let track = smooth_tangent(200.0);
+    let recorded = |v: &railforce::vehicle::Vehicle| -> Vec<f64> {
+        let cfg = SimConfig {
+            speed: 0.0,
+            duration: 0.05,
+            settle: 0.0,
+            ..SimConfig::default()
+        };
+        let mut sim = Simulation::new(v, &track, cfg).unwrap();
+        let mut rec = Recorder::new(&sim);
+        let k = rec.names().iter().position(|n| n == VEHICLE_MASS).unwrap();
+        assert_eq!(rec.units()[k], "t");
+        let mut out = Vec::new();
+        for _ in 0..50 {
+            sim.step().unwrap();
+            if let Some(row) = rec.sample(&mut sim) {
+                out.push(row[k]);
+            }
+        }
+        out
+    };
+    let (a, b) = (recorded(&base), recorded(&heavy));
+    assert!(!a.is_empty());
+    for (&x, &y) in a.iter().zip(&b) {
+        assert!(
+            (x - base.mass() * 1e-3).abs() < 1e-9,
+            "{x} t vs {} t",
+            base.mass() * 1e-3
+        );
+        assert!((y - x - 10.0).abs() < 1e-9, "{y} − {x} t");
+    }
+    for reference in [SnrReference::Std, SnrReference::Rms] {
+        let m = NoiseModel::new(0.0, reference);
+        assert_eq!(m.apply(&b, 7, VEHICLE_MASS), b);
+        assert_eq!(m.sigma_of(&b, &format!("{VEHICLE_MASS}_noisy")), 0.0);
+        assert!(m.apply(&b, 7, "carbody_acc_z") != b || reference == SnrReference::Std);
+    }
+}
+
 /// The same condition and seed draw the same values; another seed or condition draws others;
 /// the condition's own `[condition.vary]` adds its keys; scaled keys say so.
 #[test]

@@ -13,6 +13,7 @@
 //! hold marginally per window, not jointly over a section.
 
 use super::{Assessment, RunForces, Span, WheelSeries, assess};
+pub use crate::dsp::{normal_cdf, normal_quantile};
 use crate::error::{Error, Result};
 use serde::Serialize;
 
@@ -163,55 +164,4 @@ pub fn assess_with_bands(
         })
         .collect();
     Ok(central)
-}
-
-/// Φ, the standard normal CDF (erfc by Numerical Recipes' Chebyshev fit, |error| < 1.2e-7).
-pub fn normal_cdf(x: f64) -> f64 {
-    let z = x.abs() / std::f64::consts::SQRT_2;
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let erfc = t
-        * (-z * z - 1.265_512_23
-            + t * (1.000_023_68
-                + t * (0.374_091_96
-                    + t * (0.096_784_18
-                        + t * (-0.186_288_06
-                            + t * (0.278_868_07
-                                + t * (-1.135_203_98
-                                    + t * (1.488_515_87
-                                        + t * (-0.822_152_23 + t * 0.170_872_77)))))))))
-            .exp();
-    if x >= 0.0 {
-        1.0 - 0.5 * erfc
-    } else {
-        0.5 * erfc
-    }
-}
-
-/// Φ⁻¹ by bisection on [`normal_cdf`] (to its own accuracy, about 1e-7).
-pub fn normal_quantile(p: f64) -> f64 {
-    let (mut lo, mut hi) = (-10.0, 10.0);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if normal_cdf(mid) < p {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Φ and Φ⁻¹ at tabulated points.
-    #[test]
-    fn normal_distribution_at_known_points() {
-        assert!((normal_cdf(0.0) - 0.5).abs() < 1e-7);
-        assert!((normal_cdf(1.959_964) - 0.975).abs() < 1e-6);
-        assert!((normal_cdf(-1.644_854) - 0.05).abs() < 1e-6);
-        assert!((normal_quantile(0.95) - 1.644_854).abs() < 1e-5);
-        assert!(normal_quantile(0.5).abs() < 1e-6);
-    }
 }

@@ -8,7 +8,7 @@ use railforce::dataset::DataSet;
 use railforce::features::{LabelAt, NoiseProtocol, Selection, Split, SplitRequest};
 use railforce::learn::evaluate::{EvalPart, evaluate};
 use railforce::learn::model::{Model, ModelKind};
-use railforce::learn::train::{GradientEngine, Progress, TrainOptions};
+use railforce::learn::train::{DEFAULT_QUANTILE_HEADS, GradientEngine, Progress, TrainOptions};
 use railforce::learn::uncertainty::train_ensemble;
 use railforce::learn::windows::{DataRequest, DataSpec};
 use railforce::sensors::PAPER_CHANNELS;
@@ -113,12 +113,18 @@ pub struct TrainArgs {
     /// `identify` writes intervals at --coverage with one member too.
     #[arg(long, default_value_t = 1)]
     ensemble: usize,
-    /// Networks: quantile heads beside the mean, at this nominal coverage (0.9 when given
-    /// without a value): the head also learns the (1 − c)/2 and (1 + c)/2 quantiles with the
-    /// pinball loss, and the intervals follow their width (conformalised on the validation
-    /// runs like an ensemble's spread). One network's training time instead of N.
-    #[arg(long, value_name = "COVERAGE", num_args = 0..=1, default_missing_value = "0.9", conflicts_with = "ensemble")]
+    /// Networks: the quantile heads' nominal coverage (default 0.9). A single network learns,
+    /// beside the mean, the (1 − c)/2 and (1 + c)/2 quantiles with the pinball loss, and its
+    /// intervals follow their width (conformalised on the validation runs like an ensemble's
+    /// spread): the default, as well calibrated as a 5-member ensemble for one network's
+    /// training time (assets/docs/learning.md §3.1). Not for an ensemble (its spread is the
+    /// members' disagreement), classical models or the burn engine.
+    #[arg(long, value_name = "COVERAGE", conflicts_with_all = ["ensemble", "no_quantile_heads"])]
     quantile_heads: Option<f64>,
+    /// A plain network without quantile heads: one mean per target, intervals from the
+    /// validation residuals and each window's difficulty alone.
+    #[arg(long)]
+    no_quantile_heads: bool,
     /// Train anew into an --out that already holds a model or a checkpoint (without it, and
     /// without --resume, such a folder is refused so that no finished training is lost).
     #[arg(long, conflicts_with = "resume")]
@@ -253,9 +259,22 @@ pub fn run(args: TrainArgs) -> Result<()> {
             None
         },
         engine: GradientEngine::from_name(&args.engine).unwrap_or_default(),
-        quantile_heads: args.quantile_heads,
+        quantile_heads: if args.no_quantile_heads {
+            None
+        } else {
+            Some(args.quantile_heads.unwrap_or(DEFAULT_QUANTILE_HEADS))
+        },
         ..TrainOptions::default()
     };
+    if let Some(c) = args.quantile_heads
+        && opts.heads_for(kind, args.ensemble).is_none()
+    {
+        bail!(
+            "--quantile-heads {c}: quantile heads are a network's, trained with the fused engine; {} with --engine {} has none",
+            kind.name(),
+            args.engine
+        );
+    }
     let short = |t: &String| target_name(t, &ds.labels);
     println!(
         "training {} on {} ({} runs): {} channels × {} steps, label at the {} → {}",

@@ -151,7 +151,7 @@ fn kept(name: &str, kind: ChannelKind, subset: &[String]) -> bool {
 }
 
 /// The kinds a plan's `dataset.channels` may name.
-pub const CHANNEL_KINDS: [&str; 7] = [
+pub const CHANNEL_KINDS: [&str; 8] = [
     "axis",
     "input",
     "input_noisy",
@@ -159,6 +159,7 @@ pub const CHANNEL_KINDS: [&str; 7] = [
     "wheel",
     "body",
     "deflection",
+    "known",
 ];
 
 /// Progress events of a generation.

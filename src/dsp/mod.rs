@@ -7,5 +7,5 @@ pub mod welch;
 
 pub use butterworth::{Butterworth, FilterBank};
 pub use spectrum::amplitude_spectrum;
-pub use stats::percentile;
+pub use stats::{normal_cdf, normal_quantile, percentile};
 pub use welch::{WelchPsd, welch_psd};

@@ -2,7 +2,6 @@
 //! selection, and the selection file that training reads.
 
 mod mutual_info;
-pub use mutual_info::normal_quantile;
 mod samples;
 mod split;
 mod wrapper;

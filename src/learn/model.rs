@@ -127,7 +127,7 @@ fn is_one(n: &usize) -> bool {
 /// `c`, i.e. the σ of a normal law with that central interval, so the spread means what an
 /// ensemble's does and one calibration serves both (`learn::uncertainty`).
 fn quantile_spread(all: &[f32], o: usize, c: f64) -> (Vec<f32>, Option<Vec<f32>>) {
-    let z = crate::features::normal_quantile(0.5 + c / 2.0) as f32;
+    let z = crate::dsp::normal_quantile(0.5 + c / 2.0) as f32;
     let (mut mean, mut spread) = (Vec::new(), Vec::new());
     for row in all.chunks_exact(3 * o) {
         mean.extend_from_slice(&row[..o]);

@@ -52,9 +52,27 @@ pub struct TrainOptions {
     #[serde(default)]
     pub engine: GradientEngine,
     /// Networks: quantile heads at this nominal coverage beside the mean (issue 36; the
-    /// intervals then follow the heads' width, `learn::uncertainty`).
+    /// intervals then follow the heads' width, `learn::uncertainty`). The default,
+    /// [`DEFAULT_QUANTILE_HEADS`]: as well calibrated as a 5-member ensemble for a fifth of
+    /// its training time (assets/docs/learning.md §3.1). Where heads cannot apply (classical
+    /// models, an ensemble's members, the burn engine) they are left out:
+    /// [`TrainOptions::heads_for`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quantile_heads: Option<f64>,
+}
+
+/// Nominal coverage of the default quantile heads (the intervals' default coverage).
+pub const DEFAULT_QUANTILE_HEADS: f64 = 0.9;
+
+impl TrainOptions {
+    /// The quantile heads a training of `kind` as one of `members` gets: the options' own,
+    /// but none for a model without a network, for an ensemble (its members' disagreement is
+    /// its spread) and for the burn engine (heads train with the fused one).
+    pub fn heads_for(&self, kind: ModelKind, members: usize) -> Option<f64> {
+        self.quantile_heads.filter(|_| {
+            members == 1 && kind.architecture().is_some() && self.engine == GradientEngine::Fused
+        })
+    }
 }
 
 impl Default for TrainOptions {
@@ -72,7 +90,7 @@ impl Default for TrainOptions {
             fresh_noise: None,
             val_windows: None,
             engine: GradientEngine::Fused,
-            quantile_heads: None,
+            quantile_heads: Some(DEFAULT_QUANTILE_HEADS),
         }
     }
 }
@@ -225,14 +243,15 @@ pub fn train(
         members: 1,
         calibration: None,
     };
+    let heads = opts.heads_for(kind, 1);
     let engine = match kind.architecture() {
         Some(architecture) => {
             let config = NetConfig {
                 architecture,
                 window: spec.window,
                 channels: spec.channels.len(),
-                outputs: spec.targets.len() * if opts.quantile_heads.is_some() { 3 } else { 1 },
-                quantiles: opts.quantile_heads,
+                outputs: spec.targets.len() * if heads.is_some() { 3 } else { 1 },
+                quantiles: heads,
                 dropout: opts.dropout,
                 seed: opts.seed,
             };

@@ -115,24 +115,18 @@ pub fn train_ensemble(
             "an ensemble has 1 to 32 members, got {members}"
         )));
     }
-    if let Some(c) = opts.quantile_heads {
-        if members > 1 {
-            return Err(Error::Domain(
-                "quantile heads or an ensemble: a network's heads give its spread, the members' disagreement an ensemble's; choose one".into(),
-            ));
-        }
-        if kind.architecture().is_none() {
-            return Err(Error::Domain(format!(
-                "quantile heads are a network's; {} has none",
-                kind.name()
-            )));
-        }
-        if !(c > 0.0 && c < 1.0) {
-            return Err(Error::Domain(format!(
-                "the quantile heads' coverage must lie between 0 and 1, got {c}"
-            )));
-        }
+    if let Some(c) = opts.quantile_heads
+        && !(c > 0.0 && c < 1.0)
+    {
+        return Err(Error::Domain(format!(
+            "the quantile heads' coverage must lie between 0 and 1, got {c}"
+        )));
     }
+    // Heads for one network; an ensemble's spread is its members' disagreement.
+    let opts = &TrainOptions {
+        quantile_heads: opts.heads_for(kind, members),
+        ..opts.clone()
+    };
     let mut model: Option<Model> = None;
     let mut summaries = Vec::new();
     for k in 0..members {

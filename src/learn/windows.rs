@@ -364,7 +364,9 @@ impl NoiseRefresher {
             .map(|r| {
                 cols.iter()
                     .enumerate()
-                    .map(|(k, &c)| (model.sigma(&r.columns[c]) / stats.std[k]) as f32)
+                    .map(|(k, &c)| {
+                        (model.sigma_of(&r.columns[c], &ds.names[c]) / stats.std[k]) as f32
+                    })
                     .collect()
             })
             .collect();

@@ -62,6 +62,11 @@ pub fn label_channels(wheel: &str) -> [String; 2] {
     [format!("w{w}_force_y"), format!("w{w}_force_z")]
 }
 
+/// The vehicle's total mass, t: a constant of each run that an operator knows without a
+/// sensor (the weighbridge ticket, the consist list), recorded so a model may read it beside
+/// the signals (assets/docs/learning.md §4.6). Never a feature-selection candidate.
+pub const VEHICLE_MASS: &str = "vehicle_mass_t";
+
 /// Prefixes of the suspension-deflection channels (one per element kind that has a gauge).
 pub const DEFLECTION_PREFIXES: [&str; 4] = ["nest_", "pad_", "sidebearer_", "centreplate_"];
 
@@ -98,6 +103,8 @@ pub enum ChannelKind {
     Body,
     /// The deflection of a suspension element (displacement transducer).
     Deflection,
+    /// A constant of the run known without a sensor ([`VEHICLE_MASS`]).
+    Known,
 }
 
 impl ChannelKind {
@@ -105,6 +112,9 @@ impl ChannelKind {
     pub fn of(name: &str, labels: &[String; 2]) -> ChannelKind {
         if name == "time_s" || name == "s_m" {
             return ChannelKind::Axis;
+        }
+        if name == VEHICLE_MASS {
+            return ChannelKind::Known;
         }
         if is_noisy(name) {
             return ChannelKind::InputNoisy;
@@ -135,6 +145,7 @@ impl ChannelKind {
             ChannelKind::Wheel => "wheel",
             ChannelKind::Body => "body",
             ChannelKind::Deflection => "deflection",
+            ChannelKind::Known => "known",
         }
     }
 }

@@ -11,7 +11,7 @@ pub mod noise;
 pub const RATE_HZ: f64 = 200.0;
 
 pub use channels::{
-    Candidates, ChannelKind, DEFLECTION_PREFIXES, PAPER_CHANNELS, PAPER_UNITS, clean_name,
-    is_noisy, label_channels, noisy_name,
+    Candidates, ChannelKind, DEFLECTION_PREFIXES, PAPER_CHANNELS, PAPER_UNITS, VEHICLE_MASS,
+    clean_name, is_noisy, label_channels, noisy_name,
 };
 pub use noise::{NoiseModel, SnrReference};

@@ -70,9 +70,20 @@ impl NoiseModel {
         scale * 10f64.powf(-self.snr_db / 20.0)
     }
 
-    /// The noised copy of a clean channel of the run with seed `seed`.
+    /// `σ` of the noise on `channel` of one run: [`NoiseModel::sigma`], but 0 for a known
+    /// constant ([`super::VEHICLE_MASS`]: weighed, not sensed).
+    pub fn sigma_of(&self, clean: &[f64], channel: &str) -> f64 {
+        if super::clean_name(channel) == super::VEHICLE_MASS {
+            0.0
+        } else {
+            self.sigma(clean)
+        }
+    }
+
+    /// The noised copy of a clean channel of the run with seed `seed` (σ from
+    /// [`NoiseModel::sigma_of`]).
     pub fn apply(&self, clean: &[f64], seed: u64, channel: &str) -> Vec<f64> {
-        let sigma = self.sigma(clean);
+        let sigma = self.sigma_of(clean, channel);
         if !(sigma > 0.0 && sigma.is_finite()) {
             return clean.to_vec();
         }

@@ -18,6 +18,8 @@ use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+pub use crate::sensors::VEHICLE_MASS;
+
 const BODY_SIGNALS: [(&str, &str); 10] = [
     ("acc_x", "m/s2"),
     ("acc_y", "m/s2"),
@@ -84,6 +86,8 @@ impl Recorder {
                 units.push("m");
             }
         }
+        names.push(VEHICLE_MASS.into());
+        units.push("t");
         let cfg = sim.config();
         let every = (1.0 / (cfg.output_rate * cfg.dt)).round().max(1.0) as usize;
         let n = names.len();
@@ -232,6 +236,8 @@ fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
             }
         }
     }
+    // What the wagon weighs (a weighbridge, or the consist list): known, not sensed.
+    put(v.mass() * 1e-3);
     let _ = paper;
 }
 
@@ -426,6 +432,7 @@ pub fn unit_of(name: &str) -> Option<&'static str> {
     match n {
         "time_s" => return Some("s"),
         "s_m" => return Some("m"),
+        VEHICLE_MASS => return Some("t"),
         _ => {}
     }
     if let Some(k) = PAPER_CHANNELS.iter().position(|c| *c == n) {
