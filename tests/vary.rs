@@ -51,6 +51,21 @@ fn nominal_and_heavier() -> (railforce::vehicle::Vehicle, railforce::vehicle::Ve
     (base, heavy)
 }
 
+/// `v` standing still on `track` for `duration` s, no settling.
+fn at_rest<'a>(
+    v: &'a railforce::vehicle::Vehicle,
+    track: &'a railforce::track::Track,
+    duration: f64,
+) -> railforce::sim::Simulation<'a> {
+    let cfg = railforce::sim::SimConfig {
+        speed: 0.0,
+        duration,
+        settle: 0.0,
+        ..Default::default()
+    };
+    railforce::sim::Simulation::new(v, track, cfg).unwrap()
+}
+
 /// A heavier carbody raises every wheel's static load by its share: +10 t over 8 wheels is
 /// +12.26 kN per wheel, within 0.5 %.
 #[test]
@@ -71,19 +86,13 @@ fn a_heavier_draw_raises_the_static_wheel_load_by_its_share() {
 /// zeroed on the loaded wagon could not tell a part-loaded one).
 #[test]
 fn a_heavier_draw_compresses_every_pad_gauge_by_its_share() {
-    use railforce::sim::{SimConfig, Simulation, checks::smooth_tangent};
+    use railforce::sim::checks::smooth_tangent;
     use railforce::vehicle::Element;
     let (base, heavy) = nominal_and_heavier();
     let track = smooth_tangent(200.0);
     // Each pad's (vertical gauge reading, stiffness) after 0.5 s at rest.
     let pads = |v: &railforce::vehicle::Vehicle| -> Vec<(f64, f64, f64)> {
-        let cfg = SimConfig {
-            speed: 0.0,
-            duration: 0.5,
-            settle: 0.0,
-            ..SimConfig::default()
-        };
-        let mut sim = Simulation::new(v, &track, cfg).unwrap();
+        let mut sim = at_rest(v, &track, 0.5);
         for _ in 0..(0.5 / sim.config().dt).round() as usize {
             sim.step().unwrap();
         }
@@ -122,17 +131,11 @@ fn a_heavier_draw_compresses_every_pad_gauge_by_its_share() {
 #[test]
 fn the_weighed_mass_is_recorded_as_drawn_and_never_noised() {
     use railforce::sensors::{NoiseModel, SnrReference, VEHICLE_MASS};
-    use railforce::sim::{Recorder, SimConfig, Simulation, checks::smooth_tangent};
+    use railforce::sim::{Recorder, checks::smooth_tangent};
     let (base, heavy) = nominal_and_heavier();
     let track = smooth_tangent(200.0);
     let recorded = |v: &railforce::vehicle::Vehicle| -> Vec<f64> {
-        let cfg = SimConfig {
-            speed: 0.0,
-            duration: 0.05,
-            settle: 0.0,
-            ..SimConfig::default()
-        };
-        let mut sim = Simulation::new(v, &track, cfg).unwrap();
+        let mut sim = at_rest(v, &track, 0.05);
         let mut rec = Recorder::new(&sim);
         let k = rec.names().iter().position(|n| n == VEHICLE_MASS).unwrap();
         assert_eq!(rec.units()[k], "t");
