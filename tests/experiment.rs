@@ -143,7 +143,7 @@ fn every_experiment_runs_end_to_end() {
     let sensors = std::fs::read_to_string(out.join("sensors/sensors.csv")).unwrap();
     assert!(sensors.contains("selected on-board") && sensors.contains("paper's 21"));
     assert!(header("sensors/selection_fq.csv").starts_with("channel,mi_nats"));
-    // Mismatch: 2 input sets × (nominal, fleet-trained) × (nominal, fleet, 4 extremes), each
+    // Mismatch: 5 models × (nominal, fleet, 4 extremes), each
     // with its coverage and out-of-distribution share (every experiment model is calibrated).
     let mismatch = std::fs::read_to_string(out.join("mismatch/mismatch.csv")).unwrap();
     assert!(
@@ -152,9 +152,10 @@ fn every_experiment_runs_end_to_end() {
         ),
         "{mismatch}"
     );
-    // Paper's 21 and on-board, nominal- and fleet-trained (the weighed-mass model needs the
-    // experiments' data set to keep `vehicle_mass_t`: not yet, issue 36).
-    assert_eq!(mismatch.lines().count(), 1 + 2 * 2 * 6, "{mismatch}");
+    // Paper's 21 and on-board, nominal- and fleet-trained, and the fleet-trained on-board
+    // selection with the weighed mass: 5 models on 6 test sets.
+    assert_eq!(mismatch.lines().count(), 1 + 5 * 6, "{mismatch}");
+    assert!(mismatch.contains("weighed mass"), "{mismatch}");
     for case in [
         "half_payload",
         "wet_rail",

@@ -388,6 +388,10 @@ fn slim(ds: &DataSet, candidates: Candidates) -> Result<DataSet> {
     if ds.channel("s_m").is_ok() {
         keep.push("s_m".into());
     }
+    // The weighed mass: no sensor, never a selection candidate, but a model may take it.
+    if ds.channel(crate::sensors::VEHICLE_MASS).is_ok() {
+        keep.push(crate::sensors::VEHICLE_MASS.into());
+    }
     keep.extend(ds.labels.iter().cloned());
     keep.extend(candidates.among(&ds.names, &ds.labels));
     ds.subset(None, Some(&keep))
