@@ -306,6 +306,17 @@ fn select_onboard_then_train_on_noisy_inputs() {
         "{per}"
     );
     assert!(per.lines().any(|l| l.starts_with("all,")), "{per}");
+    // Every model is calibrated: the coverage of its intervals, per condition then pooled.
+    assert!(
+        out.contains("intervals at 90 % nominal coverage: FQ "),
+        "{out}"
+    );
+    let cov = std::fs::read_to_string(model.join("coverage_per_condition.csv")).unwrap();
+    assert!(
+        cov.starts_with("condition,target,coverage,coverage_se,mean_width_kn\n")
+            && cov.lines().last().unwrap().starts_with("all (pooled),FQ,"),
+        "{cov}"
+    );
     assert_eq!(meta["data"]["noise"], "Matched");
     assert_eq!(meta["data"]["noise_model"]["snr_db"], 6.0);
     assert_eq!(meta["data"]["noise_model"]["reference"], "std");

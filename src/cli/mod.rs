@@ -6,6 +6,7 @@ mod bench;
 mod builtin;
 mod calibrate;
 mod contact;
+mod evaluate;
 mod experiment;
 mod export;
 mod generate;
@@ -121,7 +122,7 @@ enum Command {
     /// Var(y_test), RMSE and MAE in kN, per condition and pooled; predictions and
     /// per-condition metrics to CSV.
     #[command(after_help = "Examples:\n  railforce evaluate --model models/demo --data data/demo")]
-    Evaluate(train::EvaluateArgs),
+    Evaluate(evaluate::EvaluateArgs),
     /// Calibrate a trained model's intervals again, on the validation runs of a data set,
     /// without training: split conformal prediction (assets/docs/learning.md §3.1), by default
     /// with intervals that follow each window's difficulty; writes model.json.
@@ -245,7 +246,7 @@ pub fn main() -> ExitCode {
         Command::Generate(args) => generate::run(args),
         Command::Select(args) => select::run(args),
         Command::Train(args) => train::run(args),
-        Command::Evaluate(args) => train::run_evaluate(args),
+        Command::Evaluate(args) => evaluate::run(args),
         Command::Calibrate(args) => calibrate::run(args),
         Command::Identify(args) => identify::run(args),
         Command::Experiment(args) => experiment::run(args),

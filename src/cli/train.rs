@@ -1,12 +1,12 @@
-//! `railforce train` and `railforce evaluate`: thin shells over `learn::train` and
-//! `learn::evaluate`.
+//! `railforce train`: a thin shell over `learn::train` (and `learn::uncertainty` for an
+//! ensemble).
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use railforce::dataset::DataSet;
 use railforce::features::{LabelAt, NoiseProtocol, Selection, Split, SplitRequest};
-use railforce::learn::evaluate::{EvalPart, evaluate};
+use railforce::learn::evaluate::target_name;
 use railforce::learn::model::{Model, ModelKind};
 use railforce::learn::train::{DEFAULT_QUANTILE_HEADS, GradientEngine, Progress, TrainOptions};
 use railforce::learn::uncertainty::train_ensemble;
@@ -400,15 +400,6 @@ pub fn run(args: TrainArgs) -> Result<()> {
     Ok(())
 }
 
-/// `FL` or `FQ` for the data set's two labels, else the channel's own name.
-fn target_name(t: &str, labels: &[String]) -> String {
-    match labels.iter().position(|l| l == t) {
-        Some(0) => "FL".into(),
-        Some(1) => "FQ".into(),
-        _ => t.to_string(),
-    }
-}
-
 /// Trains (`members` of an ensemble, one after the other) with a progress bar on standard
 /// error and one line per epoch, then calibrates.
 pub fn train_with_bar(
@@ -468,144 +459,4 @@ pub fn train_with_bar(
     )?;
     bar.finish_and_clear();
     Ok(model)
-}
-
-#[derive(Debug, Args)]
-pub struct EvaluateArgs {
-    /// Model directory written by `railforce train`.
-    #[arg(long)]
-    model: PathBuf,
-    /// Data set folder.
-    #[arg(long)]
-    data: PathBuf,
-    /// Score every window of every run (data never used in training) instead of the test
-    /// blocks of the model's own split.
-    #[arg(long)]
-    all: bool,
-    /// Predictions CSV (default: MODEL/predictions.csv).
-    #[arg(long)]
-    predictions: Option<PathBuf>,
-    /// Per-condition metrics CSV, one row per condition and target, then the pooled rows
-    /// (default: MODEL/metrics_per_condition.csv).
-    #[arg(long)]
-    metrics: Option<PathBuf>,
-}
-
-pub fn run_evaluate(args: EvaluateArgs) -> Result<()> {
-    let mut model = Model::load(&args.model)?;
-    let mut ds = DataSet::load(&args.data)?;
-    // A model that reads noisy inputs, on a data set without them: noise it as the model was
-    // noised (its recorded SNR and reference), seeded per run and channel as `generate` does.
-    if model.meta.data.noise != NoiseProtocol::Clean {
-        ds = with_noisy_copies(ds, &model.meta.data.channels, model.meta.data.noise_model)?;
-    }
-    let part = if args.all {
-        EvalPart::All
-    } else {
-        EvalPart::Test
-    };
-    let ev = evaluate(&mut model, &ds, part)?;
-    println!(
-        "{} on {} ({}; {}), {} windows, {:.0} windows/s:",
-        model.meta.kind.name(),
-        args.data.display(),
-        if args.all {
-            "all windows".to_string()
-        } else {
-            format!("test part: {}", model.meta.data.split.describe())
-        },
-        model.meta.data.noise.describe(),
-        ev.metrics.first().map(|m| m.n).unwrap_or(0),
-        ev.windows_per_s
-    );
-    let per = ev.per_condition(&model.meta.target_stats);
-    println!(
-        "{:<24} {:<14} {:>8} {:>9} {:>9} {:>9} {:>10} {:>9}",
-        "condition", "target", "windows", "MSE", "R²", "Var(y)", "RMSE kN", "MAE kN"
-    );
-    let all = ("all (pooled)".to_string(), ev.metrics.clone());
-    for (c, ms) in per.iter().chain(std::iter::once(&all)) {
-        for m in ms {
-            println!(
-                "{:<24} {:<14} {:>8} {:>9.4} {:>9.4} {:>9.4} {:>10.3} {:>9.3}",
-                c, m.target, m.n, m.mse, m.r2, m.var_y, m.rmse_kn, m.mae_kn
-            );
-        }
-    }
-    let summary: Vec<String> = ev
-        .metrics
-        .iter()
-        .enumerate()
-        .map(|(k, m)| {
-            let worst = railforce::learn::evaluate::Evaluation::worst_condition(&per, k)
-                .map(|(c, r2)| format!(", worst {c} {r2:.3}"))
-                .unwrap_or_default();
-            format!("{} R² {:.3} pooled{worst}", m.target, m.r2)
-        })
-        .collect();
-    println!(
-        "summary over {} condition(s): {}",
-        per.len(),
-        summary.join("; ")
-    );
-    let metrics_csv = args
-        .metrics
-        .unwrap_or_else(|| args.model.join("metrics_per_condition.csv"));
-    ev.write_condition_csv(&metrics_csv, &per)?;
-    println!("per-condition metrics: {}", metrics_csv.display());
-    let out = args
-        .predictions
-        .unwrap_or_else(|| args.model.join("predictions.csv"));
-    ev.write_csv(&out, &model.meta.data.targets)?;
-    println!("predictions: {}", out.display());
-    match ev.coverage() {
-        None => println!("no intervals: the model has no calibration (trained before 2026-12-02)"),
-        Some(rows) => {
-            let names: Vec<String> = model
-                .meta
-                .data
-                .targets
-                .iter()
-                .map(|t| target_name(t, &ds.labels))
-                .collect();
-            let mut csv = String::from("condition,target,coverage,coverage_se,mean_width_kn\n");
-            for r in &rows {
-                for ((n, (c, w)), se) in names.iter().zip(&r.targets).zip(&r.se) {
-                    csv += &format!("{},{n},{c:.4},{se:.4},{w:.3}\n", r.condition);
-                }
-            }
-            let pooled = rows.last().expect("pooled row");
-            let worst: Vec<String> = (0..names.len())
-                .map(|k| {
-                    let (lo, hi) = rows[..rows.len() - 1]
-                        .iter()
-                        .fold((1.0f64, 0.0f64), |a, r| {
-                            (a.0.min(r.targets[k].0), a.1.max(r.targets[k].0))
-                        });
-                    let per = &rows[..rows.len() - 1];
-                    let mut se: Vec<f64> = per.iter().map(|r| r.se[k]).collect();
-                    se.sort_by(f64::total_cmp);
-                    format!(
-                        "{} {:.1} % pooled (conditions {:.1}–{:.1} %, each measured ± {:.1} % \
-                         (median batch-means se)), mean width {:.2} kN",
-                        names[k],
-                        pooled.targets[k].0 * 100.0,
-                        lo * 100.0,
-                        hi * 100.0,
-                        se.get(se.len() / 2).copied().unwrap_or(0.0) * 100.0,
-                        pooled.targets[k].1
-                    )
-                })
-                .collect();
-            let path = args.model.join("coverage_per_condition.csv");
-            railforce::io::write_atomic(&path, |w| w.write_all(csv.as_bytes()))?;
-            println!(
-                "intervals at {:.0} % nominal coverage: {}; per condition: {}",
-                railforce::learn::evaluate::EVAL_COVERAGE * 100.0,
-                worst.join("; "),
-                path.display()
-            );
-        }
-    }
-    Ok(())
 }

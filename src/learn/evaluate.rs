@@ -58,6 +58,57 @@ pub struct CoverageRow {
     pub se: Vec<f64>,
 }
 
+/// `FL` or `FQ` for a data set's two labels (lateral, vertical), else the channel's own name.
+pub fn target_name(t: &str, labels: &[String]) -> String {
+    match labels.iter().position(|l| l == t) {
+        Some(0) => "FL".into(),
+        Some(1) => "FQ".into(),
+        _ => t.to_string(),
+    }
+}
+
+impl CoverageRow {
+    /// Writes rows (per condition, then pooled) as tidy CSV
+    /// (`condition,target,coverage,coverage_se,mean_width_kn`), `names` per target.
+    pub fn write_csv(rows: &[CoverageRow], names: &[String], path: &Path) -> Result<()> {
+        let mut csv = String::from("condition,target,coverage,coverage_se,mean_width_kn\n");
+        for r in rows {
+            for ((n, (c, w)), se) in names.iter().zip(&r.targets).zip(&r.se) {
+                let _ = writeln!(csv, "{},{n},{c:.4},{se:.4},{w:.3}", r.condition);
+            }
+        }
+        crate::io::write_atomic(path, |w| w.write_all(csv.as_bytes()))
+    }
+
+    /// One line per target: the pooled coverage, its range over the conditions, the median
+    /// standard error of a condition's figure and the mean width. `rows` end with the pooled
+    /// row, as [`Evaluation::coverage`] gives them.
+    pub fn describe(rows: &[CoverageRow], names: &[String]) -> Vec<String> {
+        let Some((pooled, per)) = rows.split_last() else {
+            return Vec::new();
+        };
+        (0..names.len())
+            .map(|k| {
+                let (lo, hi) = per.iter().fold((1.0f64, 0.0f64), |a, r| {
+                    (a.0.min(r.targets[k].0), a.1.max(r.targets[k].0))
+                });
+                let mut se: Vec<f64> = per.iter().map(|r| r.se[k]).collect();
+                se.sort_by(f64::total_cmp);
+                format!(
+                    "{} {:.1} % pooled (conditions {:.1}–{:.1} %, each measured ± {:.1} % \
+                     (median batch-means se)), mean width {:.2} kN",
+                    names[k],
+                    pooled.targets[k].0 * 100.0,
+                    lo * 100.0,
+                    hi * 100.0,
+                    se.get(se.len() / 2).copied().unwrap_or(0.0) * 100.0,
+                    pooled.targets[k].1
+                )
+            })
+            .collect()
+    }
+}
+
 /// Standard error of the mean of `inside` (0/1 per window) by batch means: windows grouped in
 /// blocks (`block[i]`), se = sd(block means) / √blocks. Zero with fewer than two blocks.
 fn batch_means_se<K: Ord + Copy>(inside: &[bool], block: &[K]) -> f64 {
