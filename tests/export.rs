@@ -61,6 +61,10 @@ fn the_file_is_safetensors_with_pytorch_names() {
     let meta = &header["__metadata__"];
     assert_eq!(meta["architecture"], "gru");
     assert_eq!(meta["targets"], "w1l_force_y,w1l_force_z");
+    // Quantile heads (train's default): three blocks of two outputs, and their coverage.
+    assert_eq!(meta["outputs"], "6");
+    assert_eq!(meta["quantile_coverage"], "0.9");
+    assert_eq!(header["out.weight"]["shape"], serde_json::json!([6, 8]));
     let mut ranges: Vec<(u64, u64)> = header
         .as_object()
         .unwrap()
@@ -197,6 +201,13 @@ fn numpy_forward_of_the_export_equals_identify_for_all_four_networks() {
         let (h1, a) = read_csv(&ours);
         let (h2, b) = read_csv(&theirs);
         assert_eq!(a.len(), b.len(), "{arch}: one estimate per window");
+        // train's default quantile heads: the export says so and numpy un-scales their
+        // lower and upper quantiles as well (6 outputs for the two targets).
+        for q in ["w1l_force_y_lower_N", "w1l_force_z_upper_N"] {
+            let j = h2.iter().position(|c| c == q);
+            let j = j.unwrap_or_else(|| panic!("{arch}: no {q} in {h2:?}"));
+            assert!(b.iter().all(|r| r[j].is_finite()), "{arch} {q}");
+        }
         let col = |h: &[String], name: &str| h.iter().position(|c| c == name).unwrap();
         let mut worst: f64 = 0.0;
         for target in ["w1l_force_y_N", "w1l_force_z_N"] {

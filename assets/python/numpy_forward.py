@@ -5,7 +5,9 @@ the engine and of the export's names and layouts (tests/export.rs runs it).
 
 reads the run's channels in the model's order, z-scores them, slides the window one sample
 at a time, and writes `time_s` (at the label position) and each target in N, as
-`railforce identify` does.
+`railforce identify` does. A model trained with quantile heads (metadata `quantile_coverage`)
+also gets each target's raw lower and upper quantiles (`<target>_lower_N`, `<target>_upper_N`),
+before the calibration `identify` applies to its intervals.
 """
 import sys
 
@@ -61,8 +63,15 @@ def gru(t, seq):
     return h
 
 
+def unscale(t, y):
+    """Standardised outputs [n, k·targets] (means, then any quantile blocks) in N."""
+    k = y.shape[1] // len(t["target_std"])
+    return y * np.tile(t["target_std"], k) + np.tile(t["target_mean"], k)
+
+
 def forward(t, meta, x):
-    """x [n, window, channels] physical → [n, targets] in N (float64 throughout)."""
+    """x [n, window, channels] physical → [n, outputs] in N (float64 throughout): the
+    targets, then, with quantile heads, their lower and upper quantiles."""
     arch = meta["architecture"]
     z = (x - t["input_mean"]) / t["input_std"]
     if arch in ("cnn-bilstm", "cnn"):
@@ -81,7 +90,7 @@ def forward(t, meta, x):
         feat = seq.reshape(seq.shape[0], -1)
     h = leaky(linear(t, "fc1", feat))
     h = leaky(linear(t, "fc2", h))
-    return linear(t, "out", h) * t["target_std"] + t["target_mean"]
+    return unscale(t, linear(t, "out", h))
 
 
 def main(model, run, out):
@@ -96,8 +105,12 @@ def main(model, run, out):
     windows = np.stack([cols[s : s + w] for s in range(n)])
     off = {"last": w - 1}.get(meta.get("label_at", "").lower(), w // 2)
     y = forward(t, meta, windows)
+    targets = meta["targets"].split(",")
+    names = [f"{c}_N" for c in targets]
+    if "quantile_coverage" in meta:
+        names += [f"{c}_lower_N" for c in targets] + [f"{c}_upper_N" for c in targets]
     with open(out, "w") as f:
-        f.write("time_s," + ",".join(f"{c}_N" for c in meta["targets"].split(",")) + "\n")
+        f.write("time_s," + ",".join(names) + "\n")
         for s in range(n):
             f.write(f"{time[s + off]:.3f}," + ",".join(f"{v:.3f}" for v in y[s]) + "\n")
 

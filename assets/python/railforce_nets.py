@@ -10,7 +10,10 @@ Conv1d(C, C, 1) → LeakyReLU → BatchNorm1d → Conv1d(C, 128, 1) → LeakyReL
 MaxPool1d(2, stride 1); then a BiLSTM (20 per direction, final states of both directions),
 a GRU (20, final state) or the flattened stem; then the head Linear(F, 64) → LeakyReLU →
 Dropout → Linear(64, 8) → LeakyReLU → Linear(8, outputs) (dropout also before fc1). Inputs
-are z-scored and outputs un-scaled with the statistics stored beside the weights.
+are z-scored and outputs un-scaled with the statistics stored beside the weights. A network
+trained with quantile heads (metadata `quantile_coverage`) returns `3 × targets` columns: the
+targets, their lower and their upper quantiles (uncalibrated; `railforce calibrate` fits the
+intervals `identify` reports).
 
 Reading the file needs `safetensors` (pip install safetensors) or nothing but this file:
 `read_safetensors` below parses the format with the standard library and numpy.
@@ -54,7 +57,7 @@ if nn is not None:
     class RailforceNet(nn.Module):
         """One of cnn-bilstm, cnn, bilstm, gru with the engine's layer table."""
 
-        def __init__(self, architecture, window, channels, outputs, dropout=0.0):
+        def __init__(self, architecture, window, channels, outputs, dropout=0.0, targets=None):
             super().__init__()
             self.architecture = architecture
             self.window, self.n_in, self.outputs = window, channels, outputs
@@ -80,7 +83,8 @@ if nn is not None:
             self.fc1 = nn.Linear(feat, 64)
             self.fc2 = nn.Linear(64, 8)
             self.out = nn.Linear(8, outputs)
-            for name, size in (("input", channels), ("target", outputs)):
+            self.targets_n = targets or outputs
+            for name, size in (("input", channels), ("target", self.targets_n)):
                 self.register_buffer(f"{name}_mean", torch.zeros(size))
                 self.register_buffer(f"{name}_std", torch.ones(size))
 
@@ -104,18 +108,25 @@ if nn is not None:
                 feat = seq.reshape(seq.shape[0], -1)  # time-major, as the engine
             h = act(self.fc1(self.drop(feat)))
             h = act(self.fc2(self.drop(h)))
-            return self.out(h) * self.target_std + self.target_mean
+            k = self.outputs // self.targets_n  # 1, or 3 with quantile heads
+            return self.out(h) * self.target_std.repeat(k) + self.target_mean.repeat(k)
 
     def load(path):
         """The network of a `railforce export` file, in eval mode, with `.channels` and
-        `.targets` (names in input and output order) and `.label_at`."""
+        `.targets` (names in input and output order), `.label_at` and `.quantile_coverage`
+        (None without quantile heads)."""
         tensors, meta = read_safetensors(path)
         channels = meta["channels"].split(",")
         targets = meta["targets"].split(",")
-        net = RailforceNet(meta["architecture"], int(meta["window"]), len(channels), len(targets))
+        outputs = int(meta.get("outputs", len(targets)))
+        net = RailforceNet(
+            meta["architecture"], int(meta["window"]), len(channels), outputs, targets=len(targets)
+        )
         state = {k: torch.from_numpy(v.copy()) for k, v in tensors.items()}
         missing, unexpected = net.load_state_dict(state, strict=False)
         if unexpected or any(not k.endswith("num_batches_tracked") for k in missing):
             raise ValueError(f"{path}: missing {missing}, unexpected {unexpected}")
         net.channels, net.targets, net.label_at = channels, targets, meta.get("label_at")
+        c = meta.get("quantile_coverage")
+        net.quantile_coverage = float(c) if c is not None else None
         return net.eval()

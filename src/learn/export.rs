@@ -188,6 +188,11 @@ pub fn to_safetensors(model: &Model) -> Result<Vec<u8>> {
             .unwrap_or_default(),
     );
     meta.insert("outputs", net.config.outputs.to_string());
+    if let Some(c) = net.config.quantiles {
+        // The output rows are then the targets' means, lower and upper quantiles at this
+        // central coverage, each block un-scaled with the target statistics.
+        meta.insert("quantile_coverage", c.to_string());
+    }
     meta.insert(
         "note",
         "written by railforce export; module: assets/python/railforce_nets.py".into(),
