@@ -322,19 +322,25 @@ fn fresh_noise_needs_the_matched_protocol() {
 }
 
 /// `--engine burn-cpu` trains the same model as the fused engine (the same files, loaded and
-/// evaluated by the engine), and a checkpoint of one engine resumes in the other.
+/// evaluated by the engine), and a checkpoint of one engine resumes in the other. Plain
+/// networks on both sides: quantile heads train with the fused engine only, so burn leaves
+/// them out (`TrainOptions::heads_for`) and the fused run must too to be the same model.
 #[cfg(feature = "burn")]
 #[test]
 fn burn_trains_the_engines_model_and_resumes_its_checkpoints() {
     use railforce::learn::train::GradientEngine;
     let ds = synthetic(2, 300);
+    let plain = |epochs| TrainOptions {
+        quantile_heads: None,
+        ..quick(epochs)
+    };
     for kind in [ModelKind::CnnBiLstm, ModelKind::Gru] {
         let fused_dir = tmp(&format!("fused-{}", kind.name()));
         let burn_dir = tmp(&format!("burn-{}", kind.name()));
-        let mut fused = train(&ds, &spec(), kind, &quick(3), &fused_dir, &mut |_| {}).unwrap();
+        let mut fused = train(&ds, &spec(), kind, &plain(3), &fused_dir, &mut |_| {}).unwrap();
         let burn_opts = TrainOptions {
             engine: GradientEngine::BurnCpu,
-            ..quick(3)
+            ..plain(3)
         };
         train(&ds, &spec(), kind, &burn_opts, &burn_dir, &mut |_| {}).unwrap();
         // The burn-trained directory is an ordinary model: the engine loads and evaluates it.
@@ -363,7 +369,7 @@ fn burn_trains_the_engines_model_and_resumes_its_checkpoints() {
         // Resume the burn run with the fused engine for two more epochs: it continues.
         let more = TrainOptions {
             resume: true,
-            ..quick(5)
+            ..plain(5)
         };
         let resumed = train(&ds, &spec(), kind, &more, &burn_dir, &mut |_| {}).unwrap();
         assert_eq!(resumed.meta.training["epochs_run"], 5, "{}", kind.name());
