@@ -559,3 +559,87 @@ fn unreadable_manifest_field_is_named() {
     let e = m.noise_model(&path).unwrap_err().to_string();
     assert!(e.contains("snr_reference") && e.contains("peak"), "{e}");
 }
+
+/// Every condition draws its own irregularities and noise at a seed; (condition, seed) repeats.
+#[test]
+fn conditions_draw_their_own_realisation() {
+    use railforce::track::{Track, TrackSpec};
+    let r = root();
+    // Two conditions of one track and speed: only their names differ.
+    let spec = TrackSpec::load(&r.join("tracks/tangent.toml")).unwrap();
+    let rails = |name: &str, seed: u64| {
+        let t = Track::new(spec.clone(), Some(dataset::realisation_seed(name, seed)));
+        let irr = t.irregularities().expect("tangent.toml has irregularities");
+        (0..50)
+            .map(|i| irr.raw_rails_at(300.0 + 7.3 * i as f64).left_y)
+            .collect::<Vec<f64>>()
+    };
+    assert_eq!(
+        rails("a", 4),
+        rails("a", 4),
+        "same condition and seed, same rails"
+    );
+    assert_ne!(
+        rails("a", 4),
+        rails("b", 4),
+        "two conditions, two realisations"
+    );
+    assert_ne!(rails("a", 4), rails("a", 5), "two seeds, two realisations");
+
+    let dir = temp("realisation");
+    let text = format!(
+        "name = \"twins\"\nvehicle = \"{}\"\nduration_s = 0.3\nseeds = [4]\n\
+         [[condition]]\nname = \"a\"\ntrack = \"{t}\"\nspeed_kmh = 80.0\n\
+         [[condition]]\nname = \"b\"\ntrack = \"{t}\"\nspeed_kmh = 80.0\n",
+        r.join("vehicles/c80.toml").display(),
+        t = r.join("tracks/tangent.toml").display()
+    );
+    let p = dir.join("twins.plan.toml");
+    std::fs::write(&p, text).unwrap();
+    let plan = Plan::load(&p).unwrap();
+    let out = dir.join("out");
+    let (m, _) = run_events(&plan, &opts(&out, Format::Csv, None));
+    for run in m["runs"].as_array().unwrap() {
+        let name = run["condition"].as_str().unwrap();
+        assert_eq!(
+            run["realisation_seed"].as_u64(),
+            Some(dataset::realisation_seed(name, 4)),
+            "the manifest records the realisation of {name}"
+        );
+    }
+    // The clean channels differ (their own rails), and so does the noise: the two runs'
+    // noise sequences (noisy − clean, each scaled by its own run's std) are uncorrelated.
+    let table = |name: &str| {
+        railforce::dataset::read_table(&out.join(format!("{name}_seed4.csv"))).unwrap()
+    };
+    let (a, b) = (table("a"), table("b"));
+    let col = |t: &[(String, Vec<f64>)], n: &str| {
+        t.iter()
+            .find(|(c, _)| c == n)
+            .map(|(_, v)| v.clone())
+            .unwrap()
+    };
+    let noisy = a
+        .iter()
+        .find(|(n, _)| n.ends_with("_noisy"))
+        .unwrap()
+        .0
+        .clone();
+    let clean = noisy.trim_end_matches("_noisy").to_string();
+    assert_ne!(
+        col(&a, &clean),
+        col(&b, &clean),
+        "each condition its own rails"
+    );
+    let noise = |t: &[(String, Vec<f64>)]| {
+        let (y, x) = (col(t, &noisy), col(t, &clean));
+        y.iter().zip(&x).map(|(y, x)| y - x).collect::<Vec<f64>>()
+    };
+    let (na, nb) = (noise(&a), noise(&b));
+    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
+    let corr = dot(&na, &nb) / (dot(&na, &na) * dot(&nb, &nb)).sqrt();
+    assert!(
+        corr.abs() < 0.3,
+        "each condition its own noise: correlation {corr:.3}"
+    );
+}

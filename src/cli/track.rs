@@ -25,11 +25,19 @@ pub struct TrackArgs {
     /// Irregularity seed (overrides the file's `irregularity.seed`).
     #[arg(long)]
     seed: Option<u64>,
+    /// With --seed: the rails of the data-set run of this condition name and seed (a plan's
+    /// runs draw their irregularities from both, so every condition has its own).
+    #[arg(long, value_name = "NAME", requires = "seed")]
+    condition: Option<String>,
 }
 
 pub fn run(args: TrackArgs) -> Result<()> {
     let spec = TrackSpec::load(&super::builtin::resolve(&args.file)?)?;
-    let track = Track::new(spec, args.seed);
+    let seed = match (&args.condition, args.seed) {
+        (Some(name), Some(seed)) => Some(railforce::dataset::realisation_seed(name, seed)),
+        _ => args.seed,
+    };
+    let track = Track::new(spec, seed);
     print_summary(&track);
     if let Some(out) = &args.out {
         track

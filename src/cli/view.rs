@@ -72,7 +72,7 @@ fn run_meta(run: &Path) -> RunMeta {
         Some((m, r)) => RunMeta {
             vehicle: Some(m.vehicle.file),
             track: Some(r.track.file),
-            seed: Some(r.seed),
+            seed: Some(r.realisation_seed.unwrap_or(r.seed)),
             speed_kmh: Some(r.speed_kmh),
         },
         None => RunMeta::default(),

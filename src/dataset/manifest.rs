@@ -94,8 +94,13 @@ pub struct RunEntry {
     pub key: String,
     /// Condition name.
     pub condition: String,
-    /// Irregularity seed.
+    /// The run's seed (the unit the splits hold out).
     pub seed: u64,
+    /// Seed of the run's irregularities and noise, [`super::realisation_seed`] of the
+    /// condition and seed (absent in manifests before 2026-12-03, whose runs drew both from
+    /// `seed` itself).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub realisation_seed: Option<u64>,
     /// Run file, relative to the data set's folder.
     pub file: String,
     /// FNV-1a 64 of the run file's bytes.
@@ -313,6 +318,8 @@ pub(super) fn run_key(
             opts.stepping.dt
         );
     }
+    // Since 2026-12-03 each condition draws its own realisation: old keys no longer match.
+    extra += &format!("|realisation={}", run.realisation_seed());
     fnv1a(
         format!(
             "{}|{}|{}|{}|{}|{}|{:?}|{}|{}|{}{extra}",

@@ -95,11 +95,27 @@ pub struct RunSpec {
     pub index: usize,
     /// Its condition.
     pub condition: Condition,
-    /// Irregularity seed.
+    /// The run's seed: the unit the splits hold out (see [`realisation_seed`] for what it draws).
     pub seed: u64,
 }
 
+/// The seed of a run's random realisation — its track irregularities and its sensor noise —
+/// from its condition's name and its seed (FNV-1a 64 of `realisation|<condition>|<seed>`).
+///
+/// Every condition draws its own realisation: with the seed alone, all conditions on tracks of
+/// one length would share one irregularity profile and one noise sequence at a seed, so the
+/// per-condition test runs of a seed would not be independent. A run is still fixed by
+/// (condition, seed): `railforce track <file> --seed S --condition NAME` shows its rails.
+pub fn realisation_seed(condition: &str, seed: u64) -> u64 {
+    crate::io::fnv1a64(format!("realisation|{condition}|{seed}").as_bytes())
+}
+
 impl RunSpec {
+    /// The seed of the run's irregularities and noise: [`realisation_seed`].
+    pub fn realisation_seed(&self) -> u64 {
+        realisation_seed(&self.condition.name, self.seed)
+    }
+
     /// Output file name.
     pub fn file_name(&self, format: Format) -> String {
         format!("{}_seed{}.{}", self.condition.name, self.seed, format.ext())
@@ -384,7 +400,7 @@ pub fn generate(
             None
         };
         let vehicle = drawn_vehicle.as_ref().unwrap_or(shared);
-        let track = Track::new(spec.clone(), Some(run.seed));
+        let track = Track::new(spec.clone(), Some(run.realisation_seed()));
         let cfg = SimConfig {
             speed: speed_kmh / 3.6,
             duration: run.condition.duration,
@@ -400,7 +416,7 @@ pub fn generate(
             Error::Domain(format!("{} (seed {}): {e}", run.condition.name, run.seed))
         })?;
         if let Some(noise) = opts.noise {
-            add_noise(&mut rec, &noise, run.seed);
+            add_noise(&mut rec, &noise, run.realisation_seed());
         }
         keep_channels(&mut rec, &labels, &dataset.channels)
             .map_err(|m| Error::config(&plan.source, "dataset.channels", m))?;
@@ -410,6 +426,7 @@ pub fn generate(
             key,
             condition: run.condition.name.clone(),
             seed: run.seed,
+            realisation_seed: Some(run.realisation_seed()),
             file: file.clone(),
             bytes_hash_fnv1a: bytes_hash,
             track: FileRef {

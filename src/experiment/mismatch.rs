@@ -22,6 +22,8 @@ use std::time::Instant;
 
 /// The fleet-trained CNN-BiLSTM on the on-board selection and the weighed mass.
 const WEIGHED: &str = "selected_weighed";
+/// The fleet-trained CNN-BiLSTM on the paper's 21 and the weighed mass.
+const PAPER_WEIGHED: &str = "paper21_weighed";
 
 /// The named extremes: folder, what it is, and its `[vary]` table (one fixed value on the
 /// nominal wagon and track; the C80's numbers).
@@ -195,6 +197,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let weighed = ctx.ds.channel(VEHICLE_MASS).is_ok();
     let mut selected_mass = selected.clone();
     selected_mass.push(VEHICLE_MASS.into());
+    let mut paper_mass = paper.clone();
+    paper_mass.push(VEHICLE_MASS.into());
     if weighed {
         inputs.push(VEHICLE_MASS.into());
     }
@@ -264,6 +268,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     // Fleet-trained only: on the nominal wagon the mass is one constant, nothing to learn from.
     let mut fleet_cases: Vec<(&str, &str, &Vec<String>)> = cases.to_vec();
     if weighed {
+        fleet_cases.push((PAPER_WEIGHED, "paper's 21 + weighed mass", &paper_mass));
         fleet_cases.push((WEIGHED, "selected on-board + weighed mass", &selected_mass));
     }
     let job = |fleet: bool, ins: &[String], name: String| -> Result<FitJob> {
@@ -435,7 +440,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     .collect::<Vec<_>>()
                     .join("; ")
             ),
-            "Trained on the nominal wagon: the generalisation (paper's 21) and sensors (on-board selection) experiments' CNN-BiLSTMs where they ran in the same invocation, or earlier into the same folder on the same data and protocol. Trained on the fleet (domain randomisation): the same network, inputs, split and noise on the fleet's training and validation seeds; and once more with the vehicle's weighed mass (`vehicle_mass_t`, a constant of each run that the weighbridge ticket gives) beside the on-board selection. Every model is calibrated by split conformal on its own validation runs: \"covered\" is the share of true forces inside its 90 % interval, \"flagged\" the share of windows with an input beyond its training envelope (the rule `identify` warns by), and the RMSE where flagged against where quiet says whether the flag fires where the error is large.".into(),
+            "Trained on the nominal wagon: the generalisation (paper's 21) and sensors (on-board selection) experiments' CNN-BiLSTMs where they ran in the same invocation, or earlier into the same folder on the same data and protocol. Trained on the fleet (domain randomisation): the same network, inputs, split and noise on the fleet's training and validation seeds; and once more with the vehicle's weighed mass (`vehicle_mass_t`, a constant of each run that the weighbridge ticket gives) beside each input set: the paper's 21 carry no load channel, so without it the payload's share of the wheel load is invisible to them. Every model is calibrated by split conformal on its own validation runs: \"covered\" is the share of true forces inside its 90 % interval, \"flagged\" the share of windows with an input beyond its training envelope (the rule `identify` warns by), and the RMSE where flagged against where quiet says whether the flag fires where the error is large.".into(),
             ctx.protocol(&ctx.split, Some(opts.snr_db)),
             format!(
                 "Time: simulation {sim_s:.0} s, trainings {train_s:.0} s ({} networks), evaluation {eval_s:.0} s; the part {:.0} s. Intervals at {:.0} %.",
