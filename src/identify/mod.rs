@@ -18,6 +18,7 @@ pub use stream::SensorRows;
 use crate::error::{Error, Result};
 use crate::features::{LabelAt, Part};
 use crate::learn::model::Model;
+use crate::learn::uncertainty::Context;
 use crate::learn::windows::label_offset;
 use std::path::Path;
 
@@ -397,15 +398,17 @@ pub fn identify_with_bands(
         }
     }
     let bands = match (coverage, &model.meta.calibration) {
-        (Some(cov), Some(_)) => {
+        (Some(cov), Some(cal)) => {
             let o = spec.targets.len();
+            let context = cal.context(&rows, c);
             Some(Bands {
                 coverage: cov,
                 bounds: (0..count)
                     .map(|s| {
                         let sp = (!spread.is_empty()).then(|| &spread[s * o..(s + 1) * o]);
                         let window = &rows[s * c..(s + w) * c];
-                        bounds(model, &out[s * o..(s + 1) * o], sp, window, cov)
+                        let ctx = context.as_ref().map(|x| (x, s + w - 1));
+                        bounds(model, &out[s * o..(s + 1) * o], sp, window, ctx, cov)
                     })
                     .collect(),
             })
@@ -416,18 +419,19 @@ pub fn identify_with_bands(
 }
 
 /// The interval (N) around one estimate: its standardised prediction `mean`, the members'
-/// `spread` per target and its standardised input `window`, at `coverage` (the model must be
-/// calibrated).
+/// `spread` per target, its standardised input `window` and the record's context at its last
+/// row, at `coverage` (the model must be calibrated).
 fn bounds(
     model: &Model,
     mean: &[f32],
     spread: Option<&[f32]>,
     window: &[f32],
+    context: Option<(&Context, usize)>,
     coverage: f64,
 ) -> Vec<(f64, f64)> {
     let cal = model.meta.calibration.as_ref().expect("a calibrated model");
     let ts = &model.meta.target_stats;
-    let level = cal.difficulty_of(window, model.meta.data.channels.len(), mean);
+    let level = cal.difficulty_of(window, model.meta.data.channels.len(), mean, context);
     (0..mean.len())
         .map(|k| {
             let sp = spread.map_or(0.0, |s| s[k] as f64);
@@ -486,16 +490,25 @@ pub struct Streamer<'a> {
     ring: std::collections::VecDeque<f32>,
     times: std::collections::VecDeque<f64>,
     x: Vec<f32>,
+    /// The running context of the intervals' difficulty, where the calibration reads one.
+    context: Option<Context>,
 }
 
 impl<'a> Streamer<'a> {
     /// A streamer over `model`.
     pub fn new(model: &'a mut Model) -> Self {
+        let c = model.meta.data.channels.len();
+        let context = model
+            .meta
+            .calibration
+            .as_ref()
+            .and_then(|cal| cal.context_stream(c));
         Streamer {
             model,
             ring: Default::default(),
             times: Default::default(),
             x: Vec::new(),
+            context,
         }
     }
 
@@ -532,6 +545,15 @@ impl<'a> Streamer<'a> {
         for (k, v) in values.iter().enumerate().take(c) {
             self.ring.push_back(z.apply(k, *v) as f32);
         }
+        if let Some(ctx) = &mut self.context {
+            let newest: Vec<f32> = self
+                .ring
+                .iter()
+                .skip(self.ring.len() - c)
+                .copied()
+                .collect();
+            ctx.push(&newest);
+        }
         self.times.push_back(time);
         while self.times.len() > w {
             self.times.pop_front();
@@ -548,7 +570,17 @@ impl<'a> Streamer<'a> {
         let (out, spread) = self.model.predict_spread(&x, 1);
         self.x = x;
         let band = match (coverage, &self.model.meta.calibration) {
-            (Some(cov), Some(_)) => Some(bounds(self.model, &out, spread.as_deref(), &self.x, cov)),
+            (Some(cov), Some(_)) => {
+                let ctx = self.context.as_ref().map(|x| (x, x.rows() - 1));
+                Some(bounds(
+                    self.model,
+                    &out,
+                    spread.as_deref(),
+                    &self.x,
+                    ctx,
+                    cov,
+                ))
+            }
             _ => None,
         };
         let outside_env = self

@@ -50,11 +50,13 @@ pub struct Calibration {
     #[serde(default)]
     pub envelope: Vec<[f64; 2]>,
     /// Per target, the weights `w` of the window's difficulty `exp(w·f(x))` that also divides
-    /// the score (locally weighted split conformal, Lei et al. 2018 §5.2): `f(x)` is 1 and
-    /// `ln(0.1 + rms)` of each standardised input over the window ([`features`]), the weights
-    /// a ridge fit of `ln |score|` on alternate 1 s blocks of the validation runs (the other
-    /// blocks calibrate), centred so the median window's difficulty is 1. Empty: none (the
-    /// score is the same everywhere but for an ensemble's spread).
+    /// the score (locally weighted split conformal, Lei et al. 2018 §5.2): `f(x)` is 1,
+    /// `ln(0.1 + rms)` of each standardised input over the window, the prediction and, where
+    /// [`Calibration::context_rows`] is set, the inputs' level over the run up to the window
+    /// ([`features`], [`Context`]); the weights a ridge fit of `ln |score|` on alternate 1 s
+    /// blocks of the validation runs (the other blocks calibrate), centred so the median
+    /// window's difficulty is 1. Empty: none (the score is the same everywhere but for an
+    /// ensemble's spread).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub difficulty: Vec<Vec<f64>>,
     /// Per target, the difficulty at the edges between [`BINS`] equally filled bins of the
@@ -66,6 +68,105 @@ pub struct Calibration {
     /// Per target and bin, the quantiles at each level `i/1000` of the score within the bin.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub binned: Vec<Vec<Vec<f64>>>,
+    /// Rows of the [`Context`] the difficulty reads, up to the window's last row; 0: none
+    /// (models calibrated before the context was added).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub context_rows: usize,
+}
+
+fn is_zero(v: &usize) -> bool {
+    *v == 0
+}
+
+/// Rows of the context of a window's difficulty, ending at the window's last row: 2000 rows,
+/// 10 s at the data sets' 200 Hz. A 0.1 s window sees too little of the track to say how hard
+/// it is; over 10 s the inputs' level and mean tell a sharp curve from a tangent and a rough
+/// realisation from a smooth one. It looks back only, so a stream gets the same intervals as
+/// the whole record (measured on paper34 at 6 dB, assets/docs/learning.md §3.1: FQ coverage
+/// of the 34 conditions' test runs 87.4–94.3 % with it, 86.1–94.4 % without, and
+/// 86.4–94.9 % for intervals calibrated on each condition's own validation run).
+pub const CONTEXT_ROWS: usize = 2000;
+
+/// Running sums of a run's standardised inputs (`c` channels), from which the context of any
+/// row comes in constant time: per channel the mean, its magnitude and `ln(0.1 + rms)` over
+/// the [`CONTEXT_ROWS`] rows up to it (fewer at the run's start). Whole records and streams
+/// sum in the same order, so both give the same numbers.
+#[derive(Debug, Clone)]
+pub struct Context {
+    c: usize,
+    span: usize,
+    /// Absolute row of the first prefix sum kept.
+    first: usize,
+    /// Prefix sums of x and x² per channel (`2c` per row boundary), from row `first`.
+    sums: Vec<f64>,
+    /// Whether rows too old to be read again are dropped (a stream).
+    bounded: bool,
+}
+
+impl Context {
+    /// The running sums of a whole run's `inputs` (`rows × c`, row-major).
+    pub fn new(inputs: &[f32], c: usize, span: usize) -> Self {
+        let mut ctx = Self::stream(c, span);
+        ctx.bounded = false;
+        for row in inputs.chunks_exact(ctx.c) {
+            ctx.push(row);
+        }
+        ctx
+    }
+
+    /// Empty running sums for a stream: feed rows with [`Context::push`].
+    pub fn stream(c: usize, span: usize) -> Self {
+        let c = c.max(1);
+        Context {
+            c,
+            span: span.max(1),
+            first: 0,
+            sums: vec![0.0; 2 * c],
+            bounded: true,
+        }
+    }
+
+    /// Appends the next row (`c` standardised values).
+    pub fn push(&mut self, row: &[f32]) {
+        let c = self.c;
+        let last = self.sums.len() - 2 * c;
+        for k in 0..2 * c {
+            let v = row[k % c] as f64;
+            let next = self.sums[last + k] + if k < c { v } else { v * v };
+            self.sums.push(next);
+        }
+        // A stream keeps what the newest row's context reads (dropped in halves).
+        let kept = self.sums.len() / (2 * c);
+        if self.bounded && kept > 2 * (self.span + 1) {
+            let drop = kept - (self.span + 1);
+            self.sums.drain(..drop * 2 * c);
+            self.first += drop;
+        }
+    }
+
+    /// Rows pushed so far.
+    pub fn rows(&self) -> usize {
+        self.first + self.sums.len() / (2 * self.c) - 1
+    }
+
+    /// The `3c` context features of row `last` (pushed, and for a stream among the newest
+    /// [`CONTEXT_ROWS`]): every channel's mean over the rows up to it, then the means'
+    /// magnitudes, then `ln(0.1 + rms)` of every channel.
+    pub fn at(&self, last: usize) -> Vec<f64> {
+        let c = self.c;
+        let hi = (last + 1).min(self.rows());
+        let lo = hi.saturating_sub(self.span).max(self.first).min(hi);
+        let n = (hi - lo).max(1) as f64;
+        let (h, l) = ((hi - self.first) * 2 * c, (lo - self.first) * 2 * c);
+        let mut f = vec![0.0; 3 * c];
+        for k in 0..c {
+            f[k] = (self.sums[h + k] - self.sums[l + k]) / n;
+            f[c + k] = f[k].abs();
+            let ms = (self.sums[h + c + k] - self.sums[l + c + k]) / n;
+            f[2 * c + k] = (0.1 + ms.max(0.0).sqrt()).ln();
+        }
+        f
+    }
 }
 
 /// Difficulty bins of the Mondrian calibration.
@@ -92,12 +193,13 @@ fn levels(scores: &[f64]) -> Vec<f64> {
 /// calibrating (1 s at 200 Hz for stride-1 windows).
 const BLOCK: usize = 200;
 
-/// The difficulty features of a standardised window `[steps × c]` and the model's standardised
-/// `prediction` for it: 1, then `ln(0.1 + rms)` of each channel over the window (the inputs'
-/// own level: faster, rougher or sharper running raises it; 0.1 keeps a silent channel
-/// finite), then each predicted target and its magnitude (a sharp curve's large lateral
-/// force). [`feature_count`] of them.
-pub fn features(window: &[f32], c: usize, prediction: &[f32]) -> Vec<f64> {
+/// The difficulty features of a standardised window `[steps × c]`, the model's standardised
+/// `prediction` for it and its `context` ([`Context::at`] of its last row, or empty): 1, then
+/// `ln(0.1 + rms)` of each channel over the window (the inputs' own level: faster, rougher or
+/// sharper running raises it; 0.1 keeps a silent channel finite), then each predicted target
+/// and its magnitude (a sharp curve's large lateral force), then the context. [`feature_count`]
+/// of them.
+pub fn features(window: &[f32], c: usize, prediction: &[f32], context: &[f64]) -> Vec<f64> {
     let steps = (window.len() / c.max(1)).max(1);
     let mut f = vec![0.0; c + 1];
     f[0] = 1.0;
@@ -109,12 +211,14 @@ pub fn features(window: &[f32], c: usize, prediction: &[f32]) -> Vec<f64> {
     }
     f.extend(prediction.iter().map(|&p| p as f64));
     f.extend(prediction.iter().map(|&p| (p as f64).abs()));
+    f.extend_from_slice(context);
     f
 }
 
-/// How many [`features`] a window of `c` channels has for a model of `outputs` targets.
-pub fn feature_count(c: usize, outputs: usize) -> usize {
-    1 + c + 2 * outputs
+/// How many [`features`] a window of `c` channels has for a model of `outputs` targets, with
+/// or without its [`Context`].
+pub fn feature_count(c: usize, outputs: usize, context: bool) -> usize {
+    1 + c + 2 * outputs + if context { 3 * c } else { 0 }
 }
 
 /// `a · b`.
@@ -258,6 +362,7 @@ impl Calibration {
             difficulty,
             edges,
             binned,
+            context_rows: 0,
         })
     }
 
@@ -303,17 +408,48 @@ impl Calibration {
         self.half_width(k, coverage, self.beta.get(k).copied().unwrap_or(0.0), 1.0)
     }
 
+    /// The context the difficulty of a run's windows reads, from the run's standardised
+    /// inputs `[rows × c]` (`None` where the calibration reads none).
+    pub fn context(&self, inputs: &[f32], c: usize) -> Option<Context> {
+        (self.context_rows > 0 && !self.difficulty.is_empty())
+            .then(|| Context::new(inputs, c, self.context_rows))
+    }
+
+    /// An empty context for a stream of `c` channels (`None` where the calibration reads
+    /// none).
+    pub fn context_stream(&self, c: usize) -> Option<Context> {
+        (self.context_rows > 0 && !self.difficulty.is_empty())
+            .then(|| Context::stream(c, self.context_rows))
+    }
+
     /// Per target, the difficulty of a standardised window `[steps × c]` with the model's
-    /// standardised `prediction` (1 where the calibration has none; the median calibration
-    /// window's is 1).
-    pub fn difficulty_of(&self, window: &[f32], c: usize, prediction: &[f32]) -> Vec<f64> {
+    /// standardised `prediction`, reading the run's `context` at the window's last row where
+    /// the calibration has one (1 where the calibration has no difficulty; the median
+    /// calibration window's is 1).
+    pub fn difficulty_of(
+        &self,
+        window: &[f32],
+        c: usize,
+        prediction: &[f32],
+        context: Option<(&Context, usize)>,
+    ) -> Vec<f64> {
         if self.difficulty.is_empty() {
             return vec![1.0; self.quantiles.len()];
         }
-        let f = features(window, c, prediction);
+        let ctx = match context {
+            Some((ctx, row)) if self.context_rows > 0 => ctx.at(row),
+            _ => Vec::new(),
+        };
+        let f = features(window, c, prediction, &ctx);
         self.difficulty
             .iter()
-            .map(|w| dot(&f, w).clamp(-5.0, 5.0).exp())
+            .map(|w| {
+                if w.len() != f.len() {
+                    // A context-reading calibration asked without one: the typical window.
+                    return 1.0;
+                }
+                dot(&f, w).clamp(-5.0, 5.0).exp()
+            })
             .collect()
     }
 }
@@ -415,7 +551,7 @@ mod tests {
                 let window: Vec<f32> = (0..c * steps)
                     .map(|_| (level * unit.sample(&mut rng)) as f32)
                     .collect();
-                x.extend(features(&window, c, &[0.0]));
+                x.extend(features(&window, c, &[0.0], &[]));
                 y.push((0.2 * level * unit.sample(&mut rng)) as f32);
                 p.push(0.0f32);
                 g.push((group, window));
@@ -430,7 +566,7 @@ mod tests {
             &pc,
             None,
             1,
-            Some((&xc, feature_count(c, 1))),
+            Some((&xc, feature_count(c, 1, false))),
             "planted".into(),
         )
         .unwrap();
@@ -439,7 +575,7 @@ mod tests {
             let idx: Vec<usize> = (0..yt.len()).filter(|&i| gt[i].0 == group).collect();
             idx.iter()
                 .filter(|&&i| {
-                    let d = cal.difficulty_of(&gt[i].1, c, &[0.0])[0];
+                    let d = cal.difficulty_of(&gt[i].1, c, &[0.0], None)[0];
                     ((yt[i] - pt[i]).abs() as f64) <= cal.half_width(0, 0.9, 0.0, d)
                 })
                 .count() as f64
@@ -450,8 +586,101 @@ mod tests {
             assert!((w - 0.9).abs() < 0.025, "group {group}: {w}");
         }
         assert!(covered(&uniform, 0) > 0.99 && covered(&uniform, 4) < 0.8);
-        let quiet =
-            weighted.half_width(0, 0.9, 0.0, weighted.difficulty_of(&gt[0].1, c, &[0.0])[0]);
+        let quiet = weighted.half_width(
+            0,
+            0.9,
+            0.0,
+            weighted.difficulty_of(&gt[0].1, c, &[0.0], None)[0],
+        );
         assert!(quiet < 0.6 * uniform.half_width(0, 0.9, 0.0, 1.0));
+    }
+    /// Planted: five kinds of run whose error σ grows 1× to 3× with a slow offset of the one
+    /// input (0 to 0.4 σ of its noise), which a 20-step window hardly sees and 2000 rows see
+    /// clearly. With the context every kind is covered within ±2.5 % of nominal; without it
+    /// the quietest and the roughest kinds miss by more. The context is the running mean and
+    /// level of the rows up to the window's end, the same from a stream as from the record.
+    #[test]
+    fn context_tells_runs_apart_that_a_window_cannot() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let unit = Normal::new(0.0, 1.0).unwrap();
+        let (c, steps, rows) = (1, 20, 3_000);
+        let mut draw = |runs: usize| {
+            let (mut y, mut p, mut plain, mut ctx, mut kind) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            for r in 0..runs {
+                let k = r % 5;
+                let x: Vec<f32> = (0..rows)
+                    .map(|_| (0.1 * k as f64 + unit.sample(&mut rng)) as f32)
+                    .collect();
+                let context = Context::new(&x, c, CONTEXT_ROWS);
+                for s in 0..rows - steps {
+                    let w = &x[s..s + steps];
+                    let row = s + steps - 1;
+                    plain.extend(features(w, c, &[0.0], &[]));
+                    ctx.extend(features(w, c, &[0.0], &context.at(row)));
+                    y.push((0.2 * (1.0 + 0.5 * k as f64) * unit.sample(&mut rng)) as f32);
+                    p.push(0.0f32);
+                    kind.push((k, w.to_vec(), context.at(row)));
+                }
+            }
+            (y, p, plain, ctx, kind)
+        };
+        let (yc, pc, xc_plain, xc_ctx, _) = draw(10);
+        let (yt, pt, _, _, kt) = draw(20);
+        let fit = |x: &[f64], context: bool| {
+            let mut cal = Calibration::fit(
+                &yc,
+                &pc,
+                None,
+                1,
+                Some((x, feature_count(c, 1, context))),
+                "planted".into(),
+            )
+            .unwrap();
+            cal.context_rows = if context { CONTEXT_ROWS } else { 0 };
+            cal
+        };
+        let (plain, with) = (fit(&xc_plain, false), fit(&xc_ctx, true));
+        let covered = |cal: &Calibration, kind: usize| {
+            let idx: Vec<usize> = (0..yt.len()).filter(|&i| kt[i].0 == kind).collect();
+            idx.iter()
+                .filter(|&&i| {
+                    let f = features(&kt[i].1, c, &[0.0], &kt[i].2);
+                    let d = if cal.context_rows > 0 {
+                        cal.difficulty
+                            .iter()
+                            .map(|w| dot(&f, w).exp())
+                            .next()
+                            .unwrap()
+                    } else {
+                        cal.difficulty_of(&kt[i].1, c, &[0.0], None)[0]
+                    };
+                    ((yt[i] - pt[i]).abs() as f64) <= cal.half_width(0, 0.9, 0.0, d)
+                })
+                .count() as f64
+                / idx.len() as f64
+        };
+        let spread = |cal: &Calibration| {
+            (0..5)
+                .map(|k| (covered(cal, k) - 0.9).abs())
+                .fold(0.0, f64::max)
+        };
+        assert!(spread(&with) < 0.025, "with the context: {}", spread(&with));
+        assert!(spread(&plain) > 0.04, "without: {}", spread(&plain));
+        // A row's context reads the rows up to it; a stream gives the same numbers.
+        let x: Vec<f32> = (0..10).map(|i| i as f32).collect();
+        let ctx = Context::new(&x, 1, 3);
+        assert_eq!(
+            ctx.at(5),
+            vec![4.0, 4.0, (0.1f64 + (50.0f64 / 3.0).sqrt()).ln()]
+        );
+        assert_eq!(ctx.at(0)[0], 0.0);
+        assert_eq!(ctx.at(1)[0], 0.5);
+        let mut stream = Context::stream(1, 3);
+        for (i, v) in x.iter().enumerate() {
+            stream.push(&[*v]);
+            assert_eq!(stream.at(i), ctx.at(i), "row {i}");
+        }
+        assert!(stream.sums.len() < ctx.sums.len());
     }
 }

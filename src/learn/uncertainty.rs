@@ -9,7 +9,7 @@
 //! coverage `c` is `ŷ ± q·(σ + β)` (or `ŷ ± q`) with `q` the `⌈(n+1)·c⌉`-th smallest of the `n`
 //! scores: marginal coverage of at least `c` on data exchangeable with the validation runs.
 
-pub use super::calibration::{Calibration, OOD_MARGIN, Score};
+pub use super::calibration::{CONTEXT_ROWS, Calibration, Context, OOD_MARGIN, Score};
 use super::model::Model;
 use super::train::{Progress, TrainOptions, train};
 use super::windows::{DataSpec, prepare};
@@ -41,13 +41,23 @@ pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Resu
     let (mut xb, mut yb) = (Vec::new(), Vec::new());
     let c = val.channels;
     let mut features = Vec::new();
+    // Each run's context, built when its first window comes (windows are in run order).
+    let mut context: Option<(usize, Context)> = None;
     let idx: Vec<usize> = (0..val.len()).collect();
     for chunk in idx.chunks(BATCH) {
         val.gather(chunk, &mut xb, &mut yb);
         let len = xb.len() / chunk.len().max(1);
         let (m, s) = model.predict_spread(&xb, chunk.len());
-        for (w, p) in xb.chunks(len.max(1)).zip(m.chunks(o)) {
-            features.extend(super::calibration::features(w, c, p));
+        for ((w, p), &i) in xb.chunks(len.max(1)).zip(m.chunks(o)).zip(chunk) {
+            let (run, last) = (val.windows[i].run as usize, val.last_row(i));
+            if context.as_ref().is_none_or(|(r, _)| *r != run) {
+                context = Some((run, Context::new(&val.inputs()[run], c, CONTEXT_ROWS)));
+            }
+            let ctx = context
+                .as_ref()
+                .map(|(_, x)| x.at(last))
+                .unwrap_or_default();
+            features.extend(super::calibration::features(w, c, p, &ctx));
         }
         y.extend_from_slice(&yb);
         mean.extend(m);
@@ -62,7 +72,10 @@ pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Resu
         &mean,
         (!spread.is_empty()).then_some(spread.as_slice()),
         o,
-        difficulty.then_some((features.as_slice(), super::calibration::feature_count(c, o))),
+        difficulty.then_some((
+            features.as_slice(),
+            super::calibration::feature_count(c, o, true),
+        )),
         format!(
             "validation part of the model's split: {} windows of {} whole runs",
             val.len(),
@@ -70,6 +83,9 @@ pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Resu
         ),
     )?;
     cal.envelope = envelope;
+    if !cal.difficulty.is_empty() {
+        cal.context_rows = CONTEXT_ROWS;
+    }
     Ok(cal)
 }
 

@@ -222,6 +222,11 @@ impl WindowSet {
         self.label_offset
     }
 
+    /// Row (time step) of window `i`'s last step in its run.
+    pub fn last_row(&self, i: usize) -> usize {
+        self.windows[i].start as usize + self.window - 1
+    }
+
     /// Row (time step) of window `i`'s label in its run.
     pub fn label_row(&self, i: usize) -> (usize, usize) {
         let w = self.windows[i];
