@@ -307,3 +307,40 @@ fn a_varied_data_set_records_its_draws_and_repeats_byte_for_byte() {
     }
     let _ = Path::new("");
 }
+
+/// A fleet's wagons share their contact table where their wheelset geometry is the same bit
+/// for bit (a heavier carbody, another friction) and get their own where it is not (another
+/// flange back): a table is built once per geometry, not once per drawn wagon.
+#[test]
+fn drawn_wagons_share_the_contact_table_of_their_geometry() {
+    let (base, heavy) = nominal_and_heavier();
+    assert!(std::ptr::eq(base.contact.table(), heavy.contact.table()));
+    let mut draws = Draws::new();
+    draws.insert(
+        "vehicle.contact.flange_back_m".into(),
+        Drawn {
+            value: toml::Value::Float(1.360),
+            scale: false,
+        },
+    );
+    let other = vehicle_for(&root().join("vehicles/c80.toml"), &draws).unwrap();
+    assert_ne!(
+        other.contact.geometry.flange_back,
+        base.contact.geometry.flange_back
+    );
+    let t = other.contact.table();
+    assert!(!std::ptr::eq(base.contact.table(), t));
+    // The other flange back moves the flange contact: the tables differ, not just their
+    // addresses.
+    assert_ne!(
+        format!("{:?}", t.states().last().map(|s| s.wheels[0].wheel_y)),
+        format!(
+            "{:?}",
+            base.contact
+                .table()
+                .states()
+                .last()
+                .map(|s| s.wheels[0].wheel_y)
+        )
+    );
+}

@@ -25,6 +25,15 @@ pub struct Profile {
 }
 
 impl Profile {
+    /// Appends the bits of everything the contact geometry reads of this profile (its sampled
+    /// shape, not its name): two profiles with equal fingerprints give the same contact.
+    pub(crate) fn fingerprint(&self, out: &mut Vec<u64>) {
+        out.extend([self.y0.to_bits(), self.h.to_bits(), self.z.len() as u64]);
+        for v in [&self.z, &self.dz, &self.d2z] {
+            out.extend(v.iter().map(|x| x.to_bits()));
+        }
+    }
+
     /// Samples `f(y) -> (z, dz/dy, d²z/dy²)` on `[y_min, y_max]`.
     pub fn from_fn(name: &str, y_min: f64, y_max: f64, f: impl Fn(f64) -> (f64, f64, f64)) -> Self {
         let n = ((y_max - y_min) / GRID_STEP).floor() as usize + 1;

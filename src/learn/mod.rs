@@ -5,6 +5,7 @@
 pub mod burn;
 mod calibration;
 pub mod classical;
+mod difficulty;
 pub mod evaluate;
 pub mod export;
 mod gradient;

@@ -37,8 +37,9 @@ pub struct ContactSettings {
     pub damping_ratio: f64,
     /// Largest flange angle of the wheel profile, rad (Nadal's limit).
     pub flange_angle: f64,
-    /// Contact table, built on first use and shared by every run of this vehicle.
-    pub(crate) table: std::sync::OnceLock<crate::contact::ContactTable>,
+    /// Contact table, built on first use and shared by every run of this vehicle (and every
+    /// vehicle of the same geometry).
+    pub(crate) table: std::sync::OnceLock<std::sync::Arc<crate::contact::ContactTable>>,
 }
 
 impl ContactSettings {
@@ -57,10 +58,13 @@ impl ContactSettings {
         }
     }
 
-    /// The contact table over ±40 mm every 0.1 mm (built once, on first use).
+    /// The contact table over ±40 mm every 0.1 mm (built on first use, or shared with any
+    /// vehicle of the same wheelset geometry built before in this process).
     pub fn table(&self) -> &crate::contact::ContactTable {
-        self.table
-            .get_or_init(|| self.geometry.table(Self::TABLE_RANGE, Self::TABLE_STEP))
+        self.table.get_or_init(|| {
+            self.geometry
+                .shared_table(Self::TABLE_RANGE, Self::TABLE_STEP)
+        })
     }
 }
 
