@@ -73,6 +73,12 @@ fn with_fleet(plan: &Plan, fleet: &Plan) -> Result<Plan> {
                 )
             })?;
         c.vary = f.vary.clone();
+        // Seeds the fleet plan adds train more wagons (validation and test stay the plan's).
+        for s in &f.seeds {
+            if !c.seeds.contains(s) {
+                c.seeds.push(*s);
+            }
+        }
     }
     if p.conditions.iter().all(|c| c.vary.is_empty()) {
         return Err(Error::config(
@@ -271,11 +277,32 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         fleet_cases.push((PAPER_WEIGHED, "paper's 21 + weighed mass", &paper_mass));
         fleet_cases.push((WEIGHED, "selected on-board + weighed mass", &selected_mass));
     }
+    // The fleet trains on every seed of its plan that neither validates nor tests: a fleet
+    // plan with more seeds than the nominal one gives its models more wagons to learn from,
+    // while validation and test stay the nominal split's.
+    let fleet_split = match &ctx.split {
+        Split::Seeds { val, test, .. } => {
+            let mut train: Vec<u64> = fleet_ds.runs.iter().map(|r| r.seed).collect();
+            train.sort_unstable();
+            train.dedup();
+            train.retain(|s| !val.contains(s) && !test.contains(s));
+            Split::Seeds {
+                train,
+                val: val.clone(),
+                test: test.clone(),
+            }
+        }
+        other => other.clone(),
+    };
     let job = |fleet: bool, ins: &[String], name: String| -> Result<FitJob> {
-        let ds = if fleet { fleet_ds } else { nominal_ds };
+        let (ds, split) = if fleet {
+            (fleet_ds, fleet_split.clone())
+        } else {
+            (nominal_ds, ctx.split.clone())
+        };
         Ok(FitJob {
             ds,
-            spec: ctx.spec(ds, ins, &labels, NoiseProtocol::Matched, ctx.split.clone())?,
+            spec: ctx.spec(ds, ins, &labels, NoiseProtocol::Matched, split)?,
             kind: ModelKind::CnnBiLstm,
             dir: dir.join(format!("models/{name}")),
             windows: None,
@@ -440,7 +467,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     .collect::<Vec<_>>()
                     .join("; ")
             ),
-            "Trained on the nominal wagon: the generalisation (paper's 21) and sensors (on-board selection) experiments' CNN-BiLSTMs where they ran in the same invocation, or earlier into the same folder on the same data and protocol. Trained on the fleet (domain randomisation): the same network, inputs, split and noise on the fleet's training and validation seeds; and once more with the vehicle's weighed mass (`vehicle_mass_t`, a constant of each run that the weighbridge ticket gives) beside each input set: the paper's 21 carry no load channel, so without it the payload's share of the wheel load is invisible to them. Every model is calibrated by split conformal on its own validation runs: \"covered\" is the share of true forces inside its 90 % interval, \"flagged\" the share of windows with an input beyond its training envelope (the rule `identify` warns by), and the RMSE where flagged against where quiet says whether the flag fires where the error is large.".into(),
+            "Trained on the nominal wagon: the generalisation (paper's 21) and sensors (on-board selection) experiments' CNN-BiLSTMs where they ran in the same invocation, or earlier into the same folder on the same data and protocol. Trained on the fleet (domain randomisation): the same network, inputs and noise; validated and tested on the nominal split's seeds, trained on every other seed of the fleet plan (more wagons where the fleet plan draws more seeds); and once more with the vehicle's weighed mass (`vehicle_mass_t`, a constant of each run that the weighbridge ticket gives) beside each input set: the paper's 21 carry no load channel, so without it the payload's share of the wheel load is invisible to them. Every model is calibrated by split conformal on its own validation runs: \"covered\" is the share of true forces inside its 90 % interval, \"flagged\" the share of windows with an input beyond its training envelope (the rule `identify` warns by), and the RMSE where flagged against where quiet says whether the flag fires where the error is large.".into(),
             ctx.protocol(&ctx.split, Some(opts.snr_db)),
             format!(
                 "Time: simulation {sim_s:.0} s, trainings {train_s:.0} s ({} networks), evaluation {eval_s:.0} s; the part {:.0} s. Intervals at {:.0} %.",

@@ -9,7 +9,7 @@
 //! coverage `c` is `ŷ ± q·(σ + β)` (or `ŷ ± q`) with `q` the `⌈(n+1)·c⌉`-th smallest of the `n`
 //! scores: marginal coverage of at least `c` on data exchangeable with the validation runs.
 
-pub use super::calibration::{CONTEXT_ROWS, Calibration, Context, OOD_MARGIN, Score};
+pub use super::calibration::{CONTEXT_ROWS, Calibration, Context, Features, OOD_MARGIN, Score};
 use super::model::Model;
 use super::train::{Progress, TrainOptions, train};
 use super::windows::{DataSpec, prepare};
@@ -43,6 +43,7 @@ pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Resu
     let mut features = Vec::new();
     // Each run's context, built when its first window comes (windows are in run order).
     let mut context: Option<(usize, Context)> = None;
+    let mut runs_of: Vec<u32> = Vec::new();
     let idx: Vec<usize> = (0..val.len()).collect();
     for chunk in idx.chunks(BATCH) {
         val.gather(chunk, &mut xb, &mut yb);
@@ -50,6 +51,7 @@ pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Resu
         let (m, s) = model.predict_spread(&xb, chunk.len());
         for ((w, p), &i) in xb.chunks(len.max(1)).zip(m.chunks(o)).zip(chunk) {
             let (run, last) = (val.windows[i].run as usize, val.last_row(i));
+            runs_of.push(run as u32);
             if context.as_ref().is_none_or(|(r, _)| *r != run) {
                 context = Some((run, Context::new(&val.inputs()[run], c, CONTEXT_ROWS)));
             }
@@ -72,10 +74,11 @@ pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Resu
         &mean,
         (!spread.is_empty()).then_some(spread.as_slice()),
         o,
-        difficulty.then_some((
-            features.as_slice(),
-            super::calibration::feature_count(c, o, true),
-        )),
+        difficulty.then_some(Features {
+            values: &features,
+            d: super::calibration::feature_count(c, o, true),
+            runs: &runs_of,
+        }),
         format!(
             "validation part of the model's split: {} windows of {} whole runs",
             val.len(),
