@@ -7,7 +7,7 @@
 /// it is; over 10 s the inputs' level and mean tell a sharp curve from a tangent and a rough
 /// realisation from a smooth one. It looks back only, so a stream gets the same intervals as
 /// the whole record (measured on paper34 at 6 dB, assets/docs/learning.md §3.1: FQ coverage
-/// of the 34 conditions' test runs 87.4–94.3 % with it, 86.1–94.4 % without, and
+/// of the 34 conditions' test runs 87.4–93.8 % with it, 86.1–94.4 % without, and
 /// 86.4–94.9 % for intervals calibrated on each condition's own validation run).
 pub const CONTEXT_ROWS: usize = 2000;
 
