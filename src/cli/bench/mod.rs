@@ -212,7 +212,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 b.real_time_factor_recorded,
                 100.0 * (b.step_recorded_us / b.step_us - 1.0)
             );
-            println!("  contact table (once per vehicle, all cores): {table_s:.2} s");
+            println!(
+                "  contact table (once per wheelset geometry in a process, all cores): {table_s:.2} s"
+            );
             println!(
                 "where a recorded step's time goes (a profiled run: {:.2} µs per step with the clock read around every part; the clock's own cost taken off):",
                 b.profiled_step_us
