@@ -542,17 +542,14 @@ impl<'a> Streamer<'a> {
             spec.channels.join(", ")
         );
         let z = &self.model.meta.input_stats;
+        let first = self.ring.len();
         for (k, v) in values.iter().enumerate().take(c) {
             self.ring.push_back(z.apply(k, *v) as f32);
         }
         if let Some(ctx) = &mut self.context {
-            let newest: Vec<f32> = self
-                .ring
-                .iter()
-                .skip(self.ring.len() - c)
-                .copied()
-                .collect();
-            ctx.push(&newest);
+            // The newest row, contiguous at the ring's back once made so.
+            let newest = self.ring.make_contiguous();
+            ctx.push(&newest[first..]);
         }
         self.times.push_back(time);
         while self.times.len() > w {
