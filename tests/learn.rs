@@ -177,6 +177,67 @@ fn same_seed_same_weights_and_resume_continues_exactly() {
 }
 
 #[test]
+fn learning_rate_halves_on_a_plateau_and_resumes_halved() {
+    let ds = synthetic(2, 300);
+    let (a, b) = (tmp("plateau-a"), tmp("plateau-b"));
+    // A rate high enough that the validation loss does not fall every epoch.
+    let opts = |epochs, resume| TrainOptions {
+        lr: 0.02,
+        lr_plateau: 1,
+        resume,
+        ..quick(epochs)
+    };
+    let mut log = Vec::new();
+    train(
+        &ds,
+        &spec(),
+        ModelKind::Gru,
+        &opts(12, false),
+        &a,
+        &mut |p| {
+            if let railforce::learn::train::Progress::Epoch(e) = p {
+                log.push(e)
+            }
+        },
+    )
+    .unwrap();
+    // Each epoch that did not improve halves the next epoch's rate; one that did keeps it.
+    assert_eq!(log[0].lr, 0.02);
+    for w in log.windows(2) {
+        let want = if w[0].best_epoch == w[0].epoch {
+            w[0].lr
+        } else {
+            w[0].lr / 2.0
+        };
+        assert_eq!(w[1].lr, want, "epoch {}", w[1].epoch);
+    }
+    assert!(log.last().unwrap().lr < 0.02, "no plateau in 12 epochs");
+    // Interrupted after 6 epochs and resumed: the halved rate comes back with the checkpoint.
+    train(
+        &ds,
+        &spec(),
+        ModelKind::Gru,
+        &opts(6, false),
+        &b,
+        &mut |_| {},
+    )
+    .unwrap();
+    train(
+        &ds,
+        &spec(),
+        ModelKind::Gru,
+        &opts(12, true),
+        &b,
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(
+        std::fs::read(a.join("weights.bin")).unwrap(),
+        std::fs::read(b.join("weights.bin")).unwrap()
+    );
+}
+
+#[test]
 fn missing_noisy_columns_are_named() {
     let ds = synthetic(1, 200);
     let s = DataSpec {

@@ -73,6 +73,10 @@ pub struct ExperimentArgs {
     /// Early-stopping patience.
     #[arg(long, default_value_t = 10)]
     patience: usize,
+    /// Halve each network's learning rate after this many epochs without a better
+    /// validation loss (0: constant).
+    #[arg(long, default_value_t = 0)]
+    lr_plateau: usize,
     /// Training windows drawn per epoch (0: all).
     #[arg(long, default_value_t = 50_000)]
     windows_per_epoch: usize,
@@ -153,6 +157,7 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
     opts.train = TrainOptions {
         epochs: args.epochs,
         patience: args.patience,
+        lr_plateau: args.lr_plateau,
         seed: args.seed,
         windows_per_epoch: (args.windows_per_epoch > 0).then_some(args.windows_per_epoch),
         ..opts.train

@@ -91,6 +91,10 @@ pub struct TrainArgs {
     /// Adam learning rate.
     #[arg(long, default_value_t = 1e-3)]
     lr: f32,
+    /// Halve the learning rate after this many epochs without a better validation loss
+    /// (reduce-on-plateau; 0 keeps it constant).
+    #[arg(long, default_value_t = 0)]
+    lr_plateau: usize,
     /// Seed of weights, shuffling and dropout.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -243,6 +247,7 @@ pub fn run(args: TrainArgs) -> Result<()> {
         patience: args.patience,
         batch: args.batch,
         lr: args.lr,
+        lr_plateau: args.lr_plateau,
         seed: args.seed,
         windows_per_epoch: args.windows_per_epoch,
         classical_rows: args.classical_rows,
@@ -313,8 +318,16 @@ pub fn run(args: TrainArgs) -> Result<()> {
     println!("  split: {}", spec.split.describe());
     if kind.architecture().is_some() {
         println!(
-            "  Adam lr {}, batch {}, at most {} epochs, patience {}, {} training windows per epoch; gradients by {}",
+            "  Adam lr {}{}, batch {}, at most {} epochs, patience {}, {} training windows per epoch; gradients by {}",
             opts.lr,
+            if opts.lr_plateau > 0 {
+                format!(
+                    " (halved after {} epochs without improvement)",
+                    opts.lr_plateau
+                )
+            } else {
+                String::new()
+            },
             opts.batch,
             opts.epochs,
             opts.patience,
@@ -440,13 +453,14 @@ pub fn train_with_bar(
                     .collect();
                 bar.suspend(|| {
                 eprintln!(
-                    "epoch {:>3}: loss train {:.4}, val {:.4}; val R² {}; {:.0} windows/s; best epoch {}",
+                    "epoch {:>3}: loss train {:.4}, val {:.4}; val R² {}; {:.0} windows/s; best epoch {}; lr {:.1e}",
                     e.epoch,
                     e.train_loss,
                     e.val_loss,
                     r2.join(", "),
                     e.windows_per_s,
-                    e.best_epoch
+                    e.best_epoch,
+                    e.lr
                 )
             });
             }

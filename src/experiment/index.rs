@@ -38,9 +38,13 @@ pub fn write_report(out: &Path) -> Result<PathBuf> {
     let count = |v: &serde_json::Value| v.as_u64().map_or("all".to_string(), |n| n.to_string());
     if t.is_object() {
         intro.push(format!(
-            "Training: Adam lr {}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch ({} on one condition), validation on at most {} windows{}; classical models on at most {} windows.",
+            "Training: Adam lr {}{}, batch {}, at most {} epochs, early stopping patience {}, {} training windows drawn per epoch ({} on one condition), validation on at most {} windows{}; classical models on at most {} windows.",
             // lr is an f32: print its decimal, not its binary expansion.
             t["lr"].as_f64().map_or("?".into(), |v| format!("{}", v as f32)),
+            match t["lr_plateau"].as_u64() {
+                Some(n) if n > 0 => format!(", halved after {n} epochs without a better validation loss"),
+                _ => String::new(),
+            },
             t["batch"],
             t["epochs"],
             t["patience"],

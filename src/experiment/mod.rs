@@ -282,8 +282,13 @@ impl Ctx<'_> {
             if let Progress::Epoch(e) = p
                 && (e.epoch % 10 == 0 || e.epoch == 1)
             {
+                let lr = if e.lr < opts.lr {
+                    format!(", lr {:.1e}", e.lr)
+                } else {
+                    String::new()
+                };
                 (self.log)(format!(
-                    "  {name}: epoch {:>3}: val {:.4}, best epoch {}, {:.0} windows/s",
+                    "  {name}: epoch {:>3}: val {:.4}, best epoch {}, {:.0} windows/s{lr}",
                     e.epoch, e.val_loss, e.best_epoch, e.windows_per_s
                 ));
             }

@@ -59,6 +59,16 @@ pub struct TrainOptions {
     /// [`TrainOptions::heads_for`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quantile_heads: Option<f64>,
+    /// Halve the learning rate each time this many epochs in a row bring no better
+    /// validation loss (reduce-on-plateau; 0: a constant rate). Early stopping still counts
+    /// from the last improvement, so a patience of 10 with a plateau of 4 halves the rate
+    /// twice before it stops.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub lr_plateau: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// Nominal coverage of the default quantile heads (the intervals' default coverage).
@@ -91,6 +101,7 @@ impl Default for TrainOptions {
             val_windows: None,
             engine: GradientEngine::Fused,
             quantile_heads: Some(DEFAULT_QUANTILE_HEADS),
+            lr_plateau: 0,
         }
     }
 }
@@ -112,6 +123,9 @@ pub struct EpochLog {
     pub seconds: f64,
     /// Best epoch so far.
     pub best_epoch: usize,
+    /// Learning rate of the epoch.
+    #[serde(default)]
+    pub lr: f32,
 }
 
 /// What the trainer reports while it works.
@@ -145,6 +159,9 @@ struct Checkpoint {
     bad_epochs: usize,
     adam_t: u64,
     fingerprint: String,
+    /// Learning-rate halvings so far (reduce-on-plateau).
+    #[serde(default)]
+    lr_halvings: u32,
 }
 
 /// Trains `kind` on `ds` and writes the model directory `out`.
@@ -349,6 +366,9 @@ struct Trainer {
     bad: usize,
     start: usize,
     log: Vec<EpochLog>,
+    /// The learning rate's halvings so far, and the rate it started at.
+    lr_halvings: u32,
+    lr0: f32,
 }
 
 impl Trainer {
@@ -367,25 +387,29 @@ impl Trainer {
             bad: 0,
             start: 0,
             log: Vec::new(),
+            lr_halvings: 0,
+            lr0: opts.lr,
         })
     }
 
     /// Identifies the model, data and settings a checkpoint belongs to.
     fn fingerprint(job: &NetJob) -> String {
         let opts = job.opts;
-        crate::dataset::fnv1a(
-            serde_json::to_string(&(
-                &job.config,
-                &job.meta.data,
-                &job.meta.data_identity,
-                opts.batch,
-                opts.lr,
-                opts.windows_per_epoch,
-                opts.fresh_noise,
-            ))
-            .expect("serialises")
-            .as_bytes(),
-        )
+        let mut key = serde_json::to_string(&(
+            &job.config,
+            &job.meta.data,
+            &job.meta.data_identity,
+            opts.batch,
+            opts.lr,
+            opts.windows_per_epoch,
+            opts.fresh_noise,
+        ))
+        .expect("serialises");
+        // A constant rate keeps the key it had before the schedule existed.
+        if opts.lr_plateau > 0 {
+            key.push_str(&format!(" lr_plateau {}", opts.lr_plateau));
+        }
+        crate::dataset::fnv1a(key.as_bytes())
     }
 
     /// Continues from the checkpoint in `out` (refused if it belongs to something else).
@@ -419,6 +443,7 @@ impl Trainer {
         self.adam.t = ck.adam_t;
         (self.best_val, self.best_epoch, self.bad, self.start) =
             (ck.best_val, ck.best_epoch, ck.bad_epochs, ck.epoch);
+        self.set_halvings(ck.lr_halvings);
         self.log = crate::io::read_text(&out.join("train_log.jsonl"))?
             .lines()
             .filter_map(|l| serde_json::from_str::<EpochLog>(l).ok())
@@ -504,8 +529,18 @@ impl Trainer {
             self.bad = 0;
         } else {
             self.bad += 1;
+            let plateau = job.opts.lr_plateau;
+            if plateau > 0 && self.bad.is_multiple_of(plateau) {
+                self.set_halvings(self.lr_halvings + 1);
+            }
         }
         Ok((val_loss, vm.iter().map(|m| m.r2).collect()))
+    }
+
+    /// The learning rate after `n` halvings of the starting one.
+    fn set_halvings(&mut self, n: u32) {
+        self.lr_halvings = n;
+        self.adam.lr = self.lr0 * 0.5f32.powi(n as i32);
     }
 
     /// Checkpoint: weights, best weights, Adam moments, counters, log.
@@ -530,6 +565,7 @@ impl Trainer {
             bad_epochs: self.bad,
             adam_t: self.adam.t,
             fingerprint: fingerprint.to_string(),
+            lr_halvings: self.lr_halvings,
         };
         let ckj = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");
         crate::io::write_atomic(&out.join("checkpoint.json"), |w| {
@@ -559,6 +595,7 @@ fn train_network(
             break;
         }
         let te = Instant::now();
+        let lr = t.adam.lr;
         let (train_loss, windows) = t.epoch(epoch, job, &mut buffers, progress)?;
         let train_s = te.elapsed().as_secs_f64();
         let (val_loss, val_r2) = t.validate(epoch, job, &vx, &vy)?;
@@ -570,6 +607,7 @@ fn train_network(
             windows_per_s: windows as f64 / train_s,
             seconds: te.elapsed().as_secs_f64(),
             best_epoch: t.best_epoch,
+            lr,
         };
         t.log.push(entry.clone());
         t.checkpoint(job.out, epoch, &fingerprint)?;
