@@ -213,24 +213,17 @@ fn learning_rate_halves_on_a_plateau_and_resumes_halved() {
     }
     assert!(log.last().unwrap().lr < 0.02, "no plateau in 12 epochs");
     // Interrupted after 6 epochs and resumed: the halved rate comes back with the checkpoint.
-    train(
-        &ds,
-        &spec(),
-        ModelKind::Gru,
-        &opts(6, false),
-        &b,
-        &mut |_| {},
-    )
-    .unwrap();
-    train(
-        &ds,
-        &spec(),
-        ModelKind::Gru,
-        &opts(12, true),
-        &b,
-        &mut |_| {},
-    )
-    .unwrap();
+    for (epochs, resume) in [(6, false), (12, true)] {
+        train(
+            &ds,
+            &spec(),
+            ModelKind::Gru,
+            &opts(epochs, resume),
+            &b,
+            &mut |_| {},
+        )
+        .unwrap();
+    }
     assert_eq!(
         std::fs::read(a.join("weights.bin")).unwrap(),
         std::fs::read(b.join("weights.bin")).unwrap()
