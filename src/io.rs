@@ -76,6 +76,15 @@ pub fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
     parse_toml(&read_text(path)?, path)
 }
 
+/// Reads and parses a JSON file into `T`; the error names the file and carries the parser's
+/// message (line and column).
+pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    serde_json::from_str(&read_text(path)?).map_err(|e| Error::Parse {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -226,11 +226,7 @@ impl Model {
     /// Reads a model directory.
     pub fn load(dir: &Path) -> Result<Self> {
         let path = dir.join("model.json");
-        let text = crate::io::read_text(&path)?;
-        let meta: ModelMeta = serde_json::from_str(&text).map_err(|e| Error::Parse {
-            file: path.clone(),
-            message: e.to_string(),
-        })?;
+        let meta: ModelMeta = crate::io::read_json(&path)?;
         if !(1..=32).contains(&meta.members) {
             return Err(Error::config(
                 &path,

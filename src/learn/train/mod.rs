@@ -331,11 +331,7 @@ impl Trainer {
     /// Continues from the checkpoint in `out` (refused if it belongs to something else).
     fn resume(&mut self, out: &Path, fingerprint: &str) -> Result<()> {
         let ck_path = out.join("checkpoint.json");
-        let text = crate::io::read_text(&ck_path)?;
-        let ck: Checkpoint = serde_json::from_str(&text).map_err(|e| Error::Parse {
-            file: ck_path.clone(),
-            message: e.to_string(),
-        })?;
+        let ck: Checkpoint = crate::io::read_json(&ck_path)?;
         if ck.fingerprint != fingerprint {
             return Err(Error::config(
                 &ck_path,
