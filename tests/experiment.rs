@@ -237,3 +237,21 @@ fn check_links(index: &Path, out: &Path, at_least: usize) -> String {
     assert!(links >= at_least, "{links} links");
     html
 }
+
+#[test]
+fn a_missing_fleet_plan_is_refused_before_any_simulation() {
+    let dir = std::env::temp_dir().join(format!("railforce-fleet-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let opts = ExperimentOptions {
+        fleet: Some(dir.join("no_such_fleet.plan.toml")),
+        ..ExperimentOptions::full(tiny_plan(&dir), dir.join("out"))
+    };
+    let err = run(&[Which::All], &opts, &|_| {}).unwrap_err().to_string();
+    assert!(err.contains("no_such_fleet.plan.toml"), "{err}");
+    assert!(
+        !dir.join("out/data").exists(),
+        "nothing simulated before the fleet plan was checked"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

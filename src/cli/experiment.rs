@@ -75,7 +75,7 @@ pub struct ExperimentArgs {
     patience: usize,
     /// Halve each network's learning rate after this many epochs without a better
     /// validation loss (0: constant).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 4)]
     lr_plateau: usize,
     /// Training windows drawn per epoch (0: all).
     #[arg(long, default_value_t = 50_000)]

@@ -93,7 +93,7 @@ pub struct TrainArgs {
     lr: f32,
     /// Halve the learning rate after this many epochs without a better validation loss
     /// (reduce-on-plateau; 0 keeps it constant).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 4)]
     lr_plateau: usize,
     /// Seed of weights, shuffling and dropout.
     #[arg(long, default_value_t = 1)]

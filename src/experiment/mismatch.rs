@@ -5,7 +5,7 @@
 //! `[vary]`), both scored on the same held-out wagons: the fleet's test-seed runs, whose draws
 //! no training or validation run shares, and four named extremes of the nominal wagon.
 
-use super::{Ctx, FitJob, PAPER21, SELECTED, f4, sensors};
+use super::{Ctx, ExperimentOptions, FitJob, PAPER21, SELECTED, f4, sensors};
 use crate::dataset::DataSet;
 use crate::error::{Error, Result};
 use crate::features::{NoiseProtocol, Split};
@@ -49,6 +49,16 @@ const EXTREMES: [(&str, &str, &str); 4] = [
         r#""track.irregularity.class" = { one_of = [4] }"#,
     ),
 ];
+
+/// The experiment's plan varied by its fleet (`opts.fleet`): loaded and checked against
+/// `plan`. `experiment::run` calls it before any simulation, so a missing or unfitting fleet
+/// plan is refused at once rather than after the earlier parts' hour.
+pub(super) fn fleet_plan(opts: &ExperimentOptions, plan: &Plan) -> Result<Plan> {
+    let fleet_path = opts.fleet.as_ref().ok_or_else(|| {
+        Error::Domain("the mismatch experiment needs a fleet plan (--fleet)".into())
+    })?;
+    with_fleet(plan, &Plan::load(fleet_path)?)
+}
 
 /// The experiment's plan with each condition's variation taken from the fleet plan's
 /// condition of the same name.
@@ -165,11 +175,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         ));
     };
     let test_seeds = test.clone();
-    let fleet_path = opts.fleet.as_ref().ok_or_else(|| {
-        Error::Domain("the mismatch experiment needs a fleet plan (--fleet)".into())
-    })?;
     let plan = Plan::load(&opts.plan)?;
-    let fleet = with_fleet(&plan, &Plan::load(fleet_path)?)?;
+    let fleet = fleet_plan(opts, &plan)?;
     let dir = opts.out.join("mismatch");
     let labels = ctx.labels();
     let paper = Ctx::paper21();
