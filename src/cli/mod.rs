@@ -148,8 +148,8 @@ enum Command {
     /// (mismatch: nominal against fleet-trained). Defaults: split by seed (independent test
     /// runs), 6 dB with σ from each channel's std, centre label. Writes tables (Markdown,
     /// CSV), SVG figures and index.html with the paper's numbers beside ours. The full
-    /// protocol on the paper's 34 conditions (`experiment all --plan paper34`) takes about
-    /// 2 hours on two cores (simulation a quarter of it, the rest training); results.md lists
+    /// protocol on the paper's 34 conditions (`experiment all --plan paper34`) took 80
+    /// minutes on two cores (simulation a quarter of it, the rest training); results.md lists
     /// what each part measured and how long it took.
     #[command(
         after_help = "Examples:\n  railforce experiment comparison --plan demo --out experiments --epochs 2 --windows-per-epoch 2000"
