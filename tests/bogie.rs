@@ -41,7 +41,7 @@ fn at_rest(v: &Vehicle) -> Vec<BodyState> {
 /// Wrenches of one element alone.
 fn wrenches(e: &Element, states: &[BodyState], memory: &mut Memory) -> Vec<Wrench> {
     let mut w = vec![Wrench::default(); states.len()];
-    e.apply(states, memory, &mut w);
+    e.apply(states, memory, &mut w, 2e-4);
     w
 }
 
@@ -235,7 +235,7 @@ fn moment_about_pad_line(
     let mut wr = vec![Wrench::default(); states.len()];
     let mut m = [0.0; 4];
     for e in elements {
-        e.apply(&states, &mut m, &mut wr);
+        e.apply(&states, &mut m, &mut wr, 2e-4);
     }
     let gravity = Vector3::new(0.0, 0.0, -v.bodies[sf].mass * 9.81);
     let f = wr[sf].force + gravity;
@@ -443,7 +443,7 @@ fn static_equilibrium_every_support_carries_the_weight_above_it() {
         let mut wr = vec![Wrench::default(); states.len()];
         let mut m = [0.0; 4];
         for e in &v.elements {
-            e.apply(&states, &mut m, &mut wr);
+            e.apply(&states, &mut m, &mut wr, 2e-4);
         }
         for (i, b) in v.bodies.iter().enumerate() {
             if v.contact.wheelsets.contains(&i) {
@@ -535,7 +535,7 @@ fn elements_are_left_right_mirror_symmetric() {
     let all = |st: &[BodyState]| {
         let mut wr = vec![Wrench::default(); st.len()];
         for e in &v.elements {
-            e.apply(st, &mut [0.0; 4], &mut wr);
+            e.apply(st, &mut [0.0; 4], &mut wr, 2e-4);
         }
         wr
     };

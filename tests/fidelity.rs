@@ -73,17 +73,35 @@ fn wedge_slider_sticks_then_slips_at_the_friction_limit() {
     let mut last = 0.0;
     for i in 0..=1000 {
         let d = i as f64 * 1e-5; // up to 10 mm
-        let f = slider(&Vector1::new(d), &zero, &mut s, k, 0.0, limit).x;
+        let f = slider(&Vector1::new(d), &zero, &mut s, k, 0.0, limit, 2e-4).x;
         let expected = (k * d).min(limit);
         assert!((f - expected).abs() < 1e-6, "d {d}: {f} vs {expected}");
         last = d;
     }
     // Slipped by d − limit/k; now back by 1 mm: sticks, force limit − k·1 mm.
     assert!((s.x - (last - limit / k)).abs() < 1e-12);
-    let f = slider(&Vector1::new(last - 1e-3), &zero, &mut s, k, 0.0, limit).x;
+    let f = slider(
+        &Vector1::new(last - 1e-3),
+        &zero,
+        &mut s,
+        k,
+        0.0,
+        limit,
+        2e-4,
+    )
+    .x;
     assert!((f - (limit - k * 1e-3)).abs() < 1e-6);
     // Far back: slips the other way at −limit.
-    let f = slider(&Vector1::new(last - 20e-3), &zero, &mut s, k, 0.0, limit).x;
+    let f = slider(
+        &Vector1::new(last - 20e-3),
+        &zero,
+        &mut s,
+        k,
+        0.0,
+        limit,
+        2e-4,
+    )
+    .x;
     assert!((f + limit).abs() < 1e-9);
     // In two dimensions the limit is a circle: the force keeps the direction of the trial.
     let mut s2 = nalgebra::Vector2::zeros();
@@ -94,8 +112,52 @@ fn wedge_slider_sticks_then_slips_at_the_friction_limit() {
         k,
         0.0,
         limit,
+        2e-4,
     );
     assert!((f.norm() - limit).abs() < 1e-6 && (f.x / f.y - 0.75).abs() < 1e-12);
+}
+
+/// A damped slider (the wedge's: stick spring and damper in parallel, in series with the
+/// slider) slipping in two dimensions while its velocity turns: the force must not depend on
+/// the step it is sampled at. The former return map reset the spring to the limit each step,
+/// dropping the damper's share, so the force swung toward the velocity by `c·|v|/limit` per
+/// step: here its direction at 0.05 / 0.2 / 0.4 ms was 2.2 / 11.9 / 19.8 mrad off the 0.025 ms
+/// one. Now the lag behind the velocity is the elasto-plastic one, `k·|v|/limit` of relaxation
+/// rate against the turn rate (2/40 = 50 mrad), at every step.
+#[test]
+fn a_damped_slider_slips_the_same_at_any_step() {
+    use nalgebra::Vector2;
+    let (k, c, limit) = (2e7, 1e4, 1e4);
+    // The face moves at 20 mm/s along a direction turning at 2 rad/s, for 0.5 s.
+    let run = |dt: f64| {
+        let mut s = Vector2::zeros();
+        let mut d = Vector2::zeros();
+        let mut f = Vector2::zeros();
+        let n = (0.5 / dt).round() as usize;
+        for i in 1..=n {
+            let t = i as f64 * dt;
+            let v = Vector2::new((2.0 * t).cos(), (2.0 * t).sin()) * 0.02;
+            d += v * dt;
+            f = slider(&d, &v, &mut s, k, c, limit, dt);
+        }
+        f
+    };
+    let angle = |a: Vector2<f64>, b: Vector2<f64>| (a.x * b.y - a.y * b.x).atan2(a.dot(&b));
+    let fine = run(2.5e-5);
+    assert!((fine.norm() - limit).abs() < 1e-6, "slipping: {fine}");
+    let v_end = Vector2::new(1.0f64.cos(), 1.0f64.sin());
+    let lag = angle(fine, v_end);
+    assert!(
+        (lag - 0.05).abs() < 2e-3,
+        "lag behind the velocity {lag} rad"
+    );
+    for dt in [5e-5, 1e-4, 2e-4, 4e-4] {
+        let off = angle(run(dt), fine);
+        assert!(
+            off.abs() < 1e-3,
+            "dt {dt}: direction {off} rad off the fine step's"
+        );
+    }
 }
 
 /// A slow lateral sweep of a loaded wheelset across the flange-root region: the load-weighted

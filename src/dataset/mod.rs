@@ -289,6 +289,11 @@ pub fn generate(
                  midpoint and the rail masses implicit, fixed step (src/sim/integrator.rs)"
                     .into()
             }
+            crate::sim::Integrator::Heun => {
+                "Heun's method (explicit trapezoidal, second order), fixed step \
+                 (src/sim/integrator.rs)"
+                    .into()
+            }
         },
         dt_s: opts.stepping.dt,
         settle_s: opts.settle,

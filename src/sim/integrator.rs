@@ -17,7 +17,7 @@
 //! deviation 4 % off at 0.4 ms against 0.2 %).
 
 use super::Simulation;
-use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector6};
+use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
 
 /// How the bodies are integrated over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -28,17 +28,21 @@ pub enum Integrator {
     /// Semi-implicit Euler with each wheelset's velocity change taken implicitly in the
     /// linearised wheel–rail damping (creep and normal).
     LinearlyImplicit,
+    /// Heun's method (explicit trapezoidal, second order): two force evaluations a step, the
+    /// friction sliders and the haul's integral advanced at the accepted state only.
+    Heun,
 }
 
 impl Integrator {
     /// Names as the command line takes them.
-    pub const NAMES: [&'static str; 2] = ["semi-implicit", "linearly-implicit"];
+    pub const NAMES: [&'static str; 3] = ["semi-implicit", "linearly-implicit", "heun"];
 
     /// Parses `semi-implicit` or `linearly-implicit`.
     pub fn parse(s: &str) -> Option<Self> {
         match s {
             "semi-implicit" => Some(Integrator::SemiImplicit),
             "linearly-implicit" => Some(Integrator::LinearlyImplicit),
+            "heun" => Some(Integrator::Heun),
             _ => None,
         }
     }
@@ -48,6 +52,7 @@ impl Integrator {
         match self {
             Integrator::SemiImplicit => Self::NAMES[0],
             Integrator::LinearlyImplicit => Self::NAMES[1],
+            Integrator::Heun => Self::NAMES[2],
         }
     }
 }
@@ -86,7 +91,7 @@ impl Simulation<'_> {
             let iw = b.inertia.component_mul(&wb);
             let dwb = (tb - wb.cross(&iw)).component_div(&b.inertia);
             let damping = match self.cfg.integrator {
-                Integrator::SemiImplicit => None,
+                Integrator::SemiImplicit | Integrator::Heun => None,
                 Integrator::LinearlyImplicit => wheelsets
                     .iter()
                     .position(|&ws| ws == i)
@@ -141,5 +146,111 @@ impl Simulation<'_> {
             let wb = rot.inverse() * st.angular_velocity;
             st.rotation = rot * UnitQuaternion::from_scaled_axis(wb * dt);
         }
+    }
+}
+
+/// A body's rates under its wrench: linear acceleration (world), angular velocity and angular
+/// acceleration in body axes (Euler's equations, principal axes).
+#[inline]
+fn body_rates(
+    b: &crate::vehicle::Body,
+    st: &crate::vehicle::BodyState,
+    w: &crate::vehicle::Wrench,
+) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let inv = st.rotation.inverse();
+    let wb = inv * st.angular_velocity;
+    let tb = inv * w.torque;
+    let dwb = (tb - wb.cross(&b.inertia.component_mul(&wb))).component_div(&b.inertia);
+    (w.force / b.mass, wb, dwb)
+}
+
+/// Acceleration of a rail mass on its support under the wheel's force `f`, m/s².
+#[inline]
+fn rail_acc(s: &crate::track::Support, x: f64, v: f64, f: f64) -> f64 {
+    (f - s.stiffness * x - s.damping * v) / s.mass
+}
+
+impl Simulation<'_> {
+    /// One step of Heun's method: the rates at the state (stage 1), an Euler predictor, the
+    /// rates there (stage 2), and the mean of the two. The wheels' results, the accelerations
+    /// and the rail forces a step reports are stage 1's (the state at the step's start, as
+    /// the other integrators report them); the sliders' memory and the haul's integral move
+    /// with stage 1 only, so stage 2 is a pure function of the predicted state.
+    pub(super) fn step_heun(&mut self) -> crate::error::Result<()> {
+        let dt = self.cfg.dt;
+        let start = self.states.clone();
+        let rails0 = self.rails.clone();
+        self.forces(true)?;
+        let rates: Vec<_> = (0..start.len())
+            .map(|i| body_rates(&self.vehicle.bodies[i], &start[i], &self.wrenches[i]))
+            .collect();
+        let support = self.track.spec().rail_support;
+        let rail_rates: Vec<[f64; 2]> = match support {
+            Some(sup) => rails0
+                .iter()
+                .zip(&self.rail_force)
+                .map(|(r, f)| {
+                    [
+                        rail_acc(&sup.lateral, r.y, r.vy, f[0]),
+                        rail_acc(&sup.vertical, r.z, r.vz, f[1]),
+                    ]
+                })
+                .collect(),
+            None => Vec::new(),
+        };
+        let (wheels, rail_force, inputs) = (
+            self.wheels.clone(),
+            self.rail_force.clone(),
+            self.inputs.clone(),
+        );
+        for (i, (st, &(acc, wb, dwb))) in self.states.iter_mut().zip(&rates).enumerate() {
+            self.accelerations[i] = acc;
+            st.position += st.velocity * dt;
+            st.velocity += acc * dt;
+            st.rotation *= UnitQuaternion::from_scaled_axis(wb * dt);
+            st.angular_velocity = st.rotation * (wb + dwb * dt);
+        }
+        for (r, a) in self.rails.iter_mut().zip(&rail_rates) {
+            r.y += r.vy * dt;
+            r.z += r.vz * dt;
+            r.vy += a[0] * dt;
+            r.vz += a[1] * dt;
+        }
+        let memory = self.memory.clone();
+        self.forces(false)?;
+        self.memory = memory;
+        let h = 0.5 * dt;
+        for (i, (st, (s0, &(acc1, wb1, dwb1)))) in self
+            .states
+            .iter_mut()
+            .zip(start.iter().zip(&rates))
+            .enumerate()
+        {
+            let (acc2, wb2, dwb2) = body_rates(&self.vehicle.bodies[i], st, &self.wrenches[i]);
+            st.position = s0.position + (s0.velocity + st.velocity) * h;
+            st.velocity = s0.velocity + (acc1 + acc2) * h;
+            st.rotation = s0.rotation * UnitQuaternion::from_scaled_axis((wb1 + wb2) * h);
+            st.angular_velocity = st.rotation * (wb1 + (dwb1 + dwb2) * h);
+        }
+        if let Some(sup) = support {
+            for (((r, r0), a1), f) in self
+                .rails
+                .iter_mut()
+                .zip(&rails0)
+                .zip(&rail_rates)
+                .zip(&self.rail_force)
+            {
+                let a2 = [
+                    rail_acc(&sup.lateral, r.y, r.vy, f[0]),
+                    rail_acc(&sup.vertical, r.z, r.vz, f[1]),
+                ];
+                r.y = r0.y + (r0.vy + r.vy) * h;
+                r.z = r0.z + (r0.vz + r.vz) * h;
+                r.vy = r0.vy + (a1[0] + a2[0]) * h;
+                r.vz = r0.vz + (a1[1] + a2[1]) * h;
+            }
+        }
+        (self.wheels, self.rail_force, self.inputs) = (wheels, rail_force, inputs);
+        Ok(())
     }
 }

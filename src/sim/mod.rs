@@ -398,6 +398,11 @@ impl<'a> Simulation<'a> {
     /// ```
     pub fn step(&mut self) -> Result<()> {
         let dt = self.cfg.dt;
+        if self.cfg.integrator == Integrator::Heun {
+            self.step_heun()?;
+            self.time += dt;
+            return self.check();
+        }
         self.forces(true)?;
         timed!(self.profile, "rails", self.move_rails());
         let t0 = self.profile.is_some().then(std::time::Instant::now);
@@ -433,7 +438,7 @@ impl<'a> Simulation<'a> {
         }
         timed!(self.profile, "force elements", {
             for (e, m) in self.vehicle.elements.iter().zip(&mut self.memory) {
-                e.apply(&self.states, m, &mut self.wrenches);
+                e.apply(&self.states, m, &mut self.wrenches, self.cfg.dt);
             }
         });
         // Wheelsets (contact) and the hauled body need their track frame every step; the

@@ -64,7 +64,12 @@ impl super::Simulation<'_> {
                 let t = Instant::now();
                 for _ in 0..reps {
                     for &i in &idx {
-                        self.vehicle.elements[i].apply(&self.states, &mut memory[i], &mut wrenches);
+                        self.vehicle.elements[i].apply(
+                            &self.states,
+                            &mut memory[i],
+                            &mut wrenches,
+                            self.cfg.dt,
+                        );
                     }
                 }
                 std::hint::black_box(&wrenches);

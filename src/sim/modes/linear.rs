@@ -310,7 +310,12 @@ impl<'a> Linear<'a> {
             let x = shape.map(|v| (v * turn).re);
             self.set(&x);
             let mut wrenches = vec![crate::vehicle::Wrench::default(); nb];
-            element.apply(&self.sim.states, &mut memory, &mut wrenches);
+            element.apply(
+                &self.sim.states,
+                &mut memory,
+                &mut wrenches,
+                self.sim.cfg.dt,
+            );
             if k >= STEPS {
                 let e = harmonic_weight(k, STEPS);
                 for (i, w) in wrenches.iter().enumerate() {

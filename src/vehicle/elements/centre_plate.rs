@@ -47,7 +47,7 @@ impl CentrePlate {
         self.friction * normal * (2.0 / 3.0) * self.radius
     }
 
-    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
         let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         let mut f = self.stiffness.component_mul(&r.d) + self.damping.component_mul(&r.v);
         f.z += self.preload;
@@ -89,6 +89,7 @@ impl CentrePlate {
             self.twist_stiffness(),
             0.0,
             self.slip_moment(normal),
+            dt,
         )
         .x;
         memory[0] = sp.x;
@@ -144,8 +145,8 @@ impl ForceElement for CentrePlate {
         Self::from_row(f, e, b)
     }
     #[inline]
-    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
-        self.forces(states, memory, wrenches)
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
+        self.forces(states, memory, wrenches, dt)
     }
     fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
         Some((&self.upper, &self.lower, &self.rest))

@@ -84,7 +84,7 @@ impl ForceElement for CrossBracing {
         Self::from_row(f, e, b)
     }
     #[inline]
-    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench]) {
+    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench], _: f64) {
         self.forces(states, wrenches)
     }
 }

@@ -91,8 +91,9 @@ pub(crate) trait ForceElement: Sized {
     /// Binds row `file` (field path `field`, e.g. `shear_pad[3]`); `bound` holds the elements
     /// bound before it (a wedge finds the nest that presses it).
     fn bind(field: &str, file: &Self::File, b: &Binder, bound: &[Element]) -> Result<Self>;
-    /// Adds the element's forces to the wrenches of its bodies.
-    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]);
+    /// Adds the element's forces to the wrenches of its bodies; `dt` is the step over which a
+    /// slider's memory advances (its damper's rate, [`wedge_damper::slider`]).
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64);
     /// Where it meets its two bodies and their static offset (kinds with gauges or supports).
     fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
         None
@@ -141,9 +142,9 @@ macro_rules! define_element {
             /// Adds this element's forces to the wrenches of the bodies it connects, updating its
             /// internal state (`memory`, used by elements with sliders).
             #[inline]
-            pub fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+            pub fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
                 match self {
-                    $(Element::$variant(e) => e.apply(states, memory, wrenches),)*
+                    $(Element::$variant(e) => e.apply(states, memory, wrenches, dt),)*
                 }
             }
 

@@ -166,7 +166,7 @@ impl ForceElement for ShearPad {
         Self::from_row(f, e, b)
     }
     #[inline]
-    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench]) {
+    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench], _: f64) {
         self.forces(states, wrenches)
     }
     fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {

@@ -46,7 +46,7 @@ impl SideBearer {
             .max(0.0)
     }
 
-    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
         let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         let normal = (self.vertical_force(r.d.z) + self.damping * r.v.z).max(0.0);
         let mut s = Vector2::new(memory[0], memory[1]);
@@ -58,6 +58,7 @@ impl SideBearer {
             self.stick_stiffness,
             0.0,
             self.friction * normal,
+            dt,
         );
         (memory[0], memory[1]) = (s.x, s.y);
         let f = Vector3::new(h.x, h.y, normal);
@@ -133,8 +134,8 @@ impl ForceElement for SideBearer {
         Self::from_row(f, e, b)
     }
     #[inline]
-    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
-        self.forces(states, memory, wrenches)
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
+        self.forces(states, memory, wrenches, dt)
     }
     fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
         Some((&self.upper, &self.lower, &self.rest))

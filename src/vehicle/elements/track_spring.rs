@@ -71,5 +71,5 @@ impl ForceElement for TrackSpring {
         Self::from_row(f, e, b)
     }
     /// Needs the track frame: the simulation applies it ([`TrackSpring::restore`]).
-    fn apply(&self, _: &[BodyState], _: &mut Memory, _: &mut [Wrench]) {}
+    fn apply(&self, _: &[BodyState], _: &mut Memory, _: &mut [Wrench], _: f64) {}
 }

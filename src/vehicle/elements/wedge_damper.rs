@@ -48,8 +48,16 @@ pub struct WedgeDamper {
     pub nest: super::SpringNest,
 }
 
-/// One elasto-plastic slider step: the trial force `k·(d − s) + c·v` kept within `limit` by
-/// moving the slider `s`; returns the force. Works for any dimension.
+/// One step of a slider: a stick spring `k` with a damper `c` in parallel, in series with a
+/// Coulomb slider `s` (memory), whose force may not exceed `limit`. The trial force
+/// `k·(d − s) + c·v` (the slider held) is returned while within the limit; beyond it the slider
+/// moves by `λ` along the trial force's direction, taken implicitly over the step `dt` (backward
+/// Euler, radial return): `k·(d − s − λ·n) + c·(v − λ·n/dt) = limit·n`, so
+/// `λ = (|trial| − limit)/(k + c/dt)` and the force sits on the limit. With `c = 0` this is the
+/// elasto-plastic return map `s = d − n·limit/k`. Before 2026-12-04 a damped slider was reset
+/// to that same point, dropping the damper's share each step: the slip direction then turned
+/// toward the velocity by `c·|v|/limit` of a radian per step, whatever the step, so the run
+/// depended on the step at first order (issue 37; `bench step`). Works for any dimension.
 #[inline]
 pub fn slider<const N: usize>(
     d: &nalgebra::SVector<f64, N>,
@@ -58,6 +66,7 @@ pub fn slider<const N: usize>(
     k: f64,
     c: f64,
     limit: f64,
+    dt: f64,
 ) -> nalgebra::SVector<f64, N> {
     let trial = (d - *s) * k + v * c;
     let n = trial.norm();
@@ -65,8 +74,11 @@ pub fn slider<const N: usize>(
         return trial;
     }
     let dir = trial / n;
-    // Slip: the spring force sits on the limit (the damper's share is dropped with it).
-    *s = d - dir * (limit / k);
+    if c == 0.0 {
+        *s = d - dir * (limit / k);
+    } else {
+        *s += dir * ((n - limit) / (k + c / dt));
+    }
     dir * limit
 }
 
@@ -89,7 +101,7 @@ impl WedgeDamper {
         )
     }
 
-    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
         let r = Relative::new(&self.upper, &self.lower, &self.rest, states);
         // The nest's own compression (its points are not the wedge's) sets the control springs.
         let n = &self.nest;
@@ -103,6 +115,7 @@ impl WedgeDamper {
             self.stick_stiffness,
             self.stick_damping,
             limit,
+            dt,
         );
         memory[0] = s.x;
         memory[1] = s.y;
@@ -124,6 +137,7 @@ impl WedgeDamper {
                 self.warp_stiffness,
                 0.0,
                 self.warp_ratio * nest_force,
+                dt,
             )
             .x;
             memory[2] = sp.x;
@@ -225,8 +239,8 @@ impl ForceElement for WedgeDamper {
         Self::from_row(f, e, nest.clone(), b)
     }
     #[inline]
-    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench]) {
-        self.forces(states, memory, wrenches)
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
+        self.forces(states, memory, wrenches, dt)
     }
     /// Reads its nest's static compression once the load path has set it.
     fn settle(&mut self, elements: &[Element]) {
