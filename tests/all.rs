@@ -28,6 +28,8 @@ mod features;
 mod fidelity;
 #[path = "identify.rs"]
 mod identify;
+#[path = "integrator.rs"]
+mod integrator;
 #[path = "learn.rs"]
 mod learn;
 #[path = "mutation.rs"]

@@ -370,8 +370,8 @@ fn linearly_implicit_step_keeps_wickens_speed() {
 /// 37's yardstick), on two conditions. In the R 400 m curve at 40 km/h, where creep is
 /// stiffest, every wheel's Y/Q rms and Q standard deviation and FL's standard deviation stay
 /// within 1 % (the current integrator at 0.4 ms: 21 %). On tangent track at 80 km/h, where
-/// creep is softer and the first-order error of the rest shows, each statistic is closer than
-/// the current integrator's at the same step and within 3 %. No power above 40 Hz gained.
+/// creep is softer, each statistic is closer than the current integrator's at the same step
+/// and within 1 % too. No power above 40 Hz gained.
 #[test]
 #[ignore = "long simulation: run in release"]
 fn linearly_implicit_step_keeps_the_statistics() {
@@ -401,7 +401,10 @@ fn linearly_implicit_step_keeps_the_statistics() {
         let d = new.trials[0].outcome.clone().unwrap();
         let e = old.trials[0].outcome.clone().unwrap();
         let stats = |d: &fidelity::StepDifference| [d.yq_rms, d.q_sd, d.label_y_sd];
-        let limit = if kmh < 60.0 { 0.01 } else { 0.03 };
+        // 1 % on both since the wedges' slider no longer depends on the step (2026-12-04:
+        // 0.13 / 0.10 / 0.14 % at 40 km/h, 0.71 / 0.14 / 0.29 % at 80 km/h, 10 s); with the
+        // former slider 0.41 % and 1.75 %.
+        let limit = 0.01;
         for (a, b) in stats(&d).into_iter().zip(stats(&e)) {
             assert!(a <= limit && a < b, "{kmh} km/h: {d:?} against {e:?}");
         }
