@@ -39,9 +39,10 @@ pub struct GenerateArgs {
     /// Settling time of each run, s (not written).
     #[arg(long, default_value_t = 3.0)]
     settle: f64,
-    /// Integrator of every run: `semi-implicit` (the default) or `linearly-implicit` (the
-    /// wheel–rail damping and the rail masses implicit; see `railforce bench step`). Recorded in
-    /// the manifest; a data set resumes only with the same choice.
+    /// Integrator of every run: `semi-implicit` (the default), `linearly-implicit` (the
+    /// wheel–rail damping and the rail masses implicit; see `railforce bench step`) or `heun`
+    /// (second order, explicit, for small steps). Recorded in the manifest; a data set resumes
+    /// only with the same choice.
     #[arg(long, default_value = "semi-implicit", value_parser = railforce::sim::Integrator::NAMES)]
     integrator: String,
     /// Integration step of every run, s.

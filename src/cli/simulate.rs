@@ -36,9 +36,10 @@ pub struct SimulateArgs {
     /// Integration step, s.
     #[arg(long, default_value_t = 2e-4)]
     dt: f64,
-    /// Integrator: `semi-implicit` (explicit in every force) or `linearly-implicit` (the
+    /// Integrator: `semi-implicit` (explicit in every force), `linearly-implicit` (the
     /// wheel–rail damping and the rail masses taken implicitly: accurate at larger steps,
-    /// `railforce bench step`).
+    /// `railforce bench step`) or `heun` (second order, two force evaluations a step, explicit:
+    /// a reference for small steps).
     #[arg(long, default_value = "semi-implicit", value_parser = railforce::sim::Integrator::NAMES)]
     integrator: String,
     /// Report a derailment but keep running (default: stop with an error).
