@@ -71,37 +71,21 @@ fn wedge_slider_sticks_then_slips_at_the_friction_limit() {
     let mut s = Vector1::zeros();
     let zero = Vector1::zeros();
     let mut last = 0.0;
+    let at =
+        |d: f64, s: &mut Vector1<f64>| slider(&Vector1::new(d), &zero, s, k, 0.0, limit, 2e-4).x;
     for i in 0..=1000 {
         let d = i as f64 * 1e-5; // up to 10 mm
-        let f = slider(&Vector1::new(d), &zero, &mut s, k, 0.0, limit, 2e-4).x;
+        let f = at(d, &mut s);
         let expected = (k * d).min(limit);
         assert!((f - expected).abs() < 1e-6, "d {d}: {f} vs {expected}");
         last = d;
     }
     // Slipped by d − limit/k; now back by 1 mm: sticks, force limit − k·1 mm.
     assert!((s.x - (last - limit / k)).abs() < 1e-12);
-    let f = slider(
-        &Vector1::new(last - 1e-3),
-        &zero,
-        &mut s,
-        k,
-        0.0,
-        limit,
-        2e-4,
-    )
-    .x;
+    let f = at(last - 1e-3, &mut s);
     assert!((f - (limit - k * 1e-3)).abs() < 1e-6);
     // Far back: slips the other way at −limit.
-    let f = slider(
-        &Vector1::new(last - 20e-3),
-        &zero,
-        &mut s,
-        k,
-        0.0,
-        limit,
-        2e-4,
-    )
-    .x;
+    let f = at(last - 20e-3, &mut s);
     assert!((f + limit).abs() < 1e-9);
     // In two dimensions the limit is a circle: the force keeps the direction of the trial.
     let mut s2 = nalgebra::Vector2::zeros();
