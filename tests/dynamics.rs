@@ -443,3 +443,32 @@ fn a_profiled_step_names_its_parts_and_changes_nothing() {
         c80().elements.len()
     );
 }
+
+/// A derailment risk (|Y/Q| above Nadal's limit for 50 ms; the limit set low here, flange
+/// angle 22°, so a wheel's steady curving Y/Q in R 400 m holds it) stops a run by
+/// default and is only reported where the config says so, as data generation does: the run
+/// then finishes with every row finite.
+#[test]
+fn a_derailment_risk_stops_a_run_only_when_asked() {
+    // Smooth rails, so the run may start in the circular curve.
+    let mut spec = TrackSpec::load(&root().join("tracks/curve_r400.toml")).unwrap();
+    spec.irregularity = None;
+    let track = Track::new(spec, None);
+    let cfg = |stop| SimConfig {
+        speed: 60.0 / 3.6,
+        duration: 0.3,
+        settle: 0.3,
+        start: Some(500.0),
+        nadal_angle: Some(22f64.to_radians()),
+        stop_on_derailment_risk: stop,
+        ..SimConfig::default()
+    };
+    let run = |stop| {
+        let mut sim = Simulation::new(c80(), &track, cfg(stop)).unwrap();
+        output::record(&mut sim, |_| {})
+    };
+    let err = run(true).unwrap_err().to_string();
+    assert!(err.contains("derailment risk"), "{err}");
+    let rec = run(false).unwrap();
+    assert!(rec.rows.len() >= 60 && rec.rows.iter().flatten().all(|x| x.is_finite()));
+}
