@@ -37,7 +37,7 @@ impl Integrator {
     /// Names as the command line takes them.
     pub const NAMES: [&'static str; 3] = ["semi-implicit", "linearly-implicit", "heun"];
 
-    /// Parses `semi-implicit` or `linearly-implicit`.
+    /// Parses `semi-implicit`, `linearly-implicit` or `heun`.
     pub fn parse(s: &str) -> Option<Self> {
         match s {
             "semi-implicit" => Some(Integrator::SemiImplicit),
@@ -84,12 +84,8 @@ impl Simulation<'_> {
         let wheelsets = &self.vehicle.contact.wheelsets;
         for (i, (st, w)) in self.states.iter_mut().zip(&self.wrenches).enumerate() {
             let b = &self.vehicle.bodies[i];
-            let acc = w.force / b.mass;
+            let (acc, wb, dwb) = body_rates(b, st, w);
             let rot = st.rotation;
-            let wb = rot.inverse() * st.angular_velocity;
-            let tb = rot.inverse() * w.torque;
-            let iw = b.inertia.component_mul(&wb);
-            let dwb = (tb - wb.cross(&iw)).component_div(&b.inertia);
             let damping = match self.cfg.integrator {
                 Integrator::SemiImplicit | Integrator::Heun => None,
                 Integrator::LinearlyImplicit => wheelsets
@@ -164,12 +160,6 @@ fn body_rates(
     (w.force / b.mass, wb, dwb)
 }
 
-/// Acceleration of a rail mass on its support under the wheel's force `f`, m/s².
-#[inline]
-fn rail_acc(s: &crate::track::Support, x: f64, v: f64, f: f64) -> f64 {
-    (f - s.stiffness * x - s.damping * v) / s.mass
-}
-
 impl Simulation<'_> {
     /// One step of Heun's method: the rates at the state (stage 1), an Euler predictor, the
     /// rates there (stage 2), and the mean of the two. The wheels' results, the accelerations
@@ -191,8 +181,8 @@ impl Simulation<'_> {
                 .zip(&self.rail_force)
                 .map(|(r, f)| {
                     [
-                        rail_acc(&sup.lateral, r.y, r.vy, f[0]),
-                        rail_acc(&sup.vertical, r.z, r.vz, f[1]),
+                        sup.lateral.acceleration(r.y, r.vy, f[0]),
+                        sup.vertical.acceleration(r.z, r.vz, f[1]),
                     ]
                 })
                 .collect(),
@@ -241,8 +231,8 @@ impl Simulation<'_> {
                 .zip(&self.rail_force)
             {
                 let a2 = [
-                    rail_acc(&sup.lateral, r.y, r.vy, f[0]),
-                    rail_acc(&sup.vertical, r.z, r.vz, f[1]),
+                    sup.lateral.acceleration(r.y, r.vy, f[0]),
+                    sup.vertical.acceleration(r.z, r.vz, f[1]),
                 ];
                 r.y = r0.y + (r0.vy + r.vy) * h;
                 r.z = r0.z + (r0.vz + r.vz) * h;

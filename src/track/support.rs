@@ -26,11 +26,18 @@ impl Support {
         (self.stiffness / self.mass).sqrt() / (2.0 * std::f64::consts::PI)
     }
 
+    /// Acceleration of the mass at displacement `x` and velocity `v` under the external
+    /// force `f` (N), m/s².
+    #[inline]
+    pub fn acceleration(&self, x: f64, v: f64, f: f64) -> f64 {
+        (f - self.stiffness * x - self.damping * v) / self.mass
+    }
+
     /// One semi-implicit Euler step of the mass at displacement `x` and velocity `v` under
     /// the external force `f` (N) for `dt` (s).
     #[inline]
     pub fn step(&self, x: &mut f64, v: &mut f64, f: f64, dt: f64) {
-        *v += (f - self.stiffness * *x - self.damping * *v) / self.mass * dt;
+        *v += self.acceleration(*x, *v, f) * dt;
         *x += *v * dt;
     }
 }
