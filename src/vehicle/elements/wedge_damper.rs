@@ -74,6 +74,8 @@ pub fn slider<const N: usize>(
         return trial;
     }
     let dir = trial / n;
+    // Undamped, the same point in the return map's own form: the side bearers', centre
+    // plates' and warp sliders' runs stay bit-identical to before the damped form.
     if c == 0.0 {
         *s = d - dir * (limit / k);
     } else {
