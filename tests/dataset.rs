@@ -89,7 +89,7 @@ fn generate_resume_shard_merge_and_formats() {
     assert_eq!(kind("w3r_force_y").as_deref(), Some("wheel"));
     assert!(channels.iter().all(|c| c["unit"].is_string()));
     // The manifest says how the runs were made: the integration step and settling time.
-    assert_eq!(m["integration"]["dt_s"], 2e-4);
+    assert_eq!(m["integration"]["dt_s"], 5e-4);
     assert!(m["integration"]["settle_s"].is_number());
     assert!(m["integration"]["integrator"].is_string());
     let file = a.join("tangent_v80_seed1.npz");
@@ -113,8 +113,8 @@ fn generate_resume_shard_merge_and_formats() {
     // the forces differ; a step outside (0, 1 ms] is refused before any run.
     let li = dir.join("li");
     let stepping = railforce::sim::Stepping {
-        integrator: railforce::sim::Integrator::LinearlyImplicit,
-        dt: 4e-4,
+        integrator: railforce::sim::Integrator::SemiImplicit,
+        dt: 2e-4,
     };
     std::fs::create_dir_all(&li).unwrap();
     for f in ["manifest.json", "tangent_v80_seed1.npz"] {
@@ -126,12 +126,12 @@ fn generate_resume_shard_merge_and_formats() {
     };
     let (m_li, ev) = run_events(&plan, &o);
     assert_eq!(started(&ev), 3, "another integrator resumes nothing");
-    assert_eq!(m_li["integration"]["dt_s"], 4e-4);
+    assert_eq!(m_li["integration"]["dt_s"], 2e-4);
     assert!(
         m_li["integration"]["integrator"]
             .as_str()
             .unwrap()
-            .starts_with("linearly implicit")
+            .starts_with("semi-implicit")
     );
     let li_cols = npz::read_npz(&std::fs::read(li.join("tangent_v80_seed1.npz")).unwrap()).unwrap();
     let q = |c: &[(String, Vec<f64>)]| {

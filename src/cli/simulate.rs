@@ -33,15 +33,16 @@ pub struct SimulateArgs {
     /// Settling time before recording, s (not written out).
     #[arg(long, default_value_t = 3.0)]
     settle: f64,
-    /// Integration step, s.
-    #[arg(long, default_value_t = 2e-4)]
-    dt: f64,
-    /// Integrator: `semi-implicit` (explicit in every force), `linearly-implicit` (the
-    /// wheel–rail damping and the rail masses taken implicitly: accurate at larger steps,
-    /// `railforce bench step`) or `heun` (second order, two force evaluations a step, explicit:
-    /// a reference for small steps).
-    #[arg(long, default_value = "semi-implicit", value_parser = railforce::sim::Integrator::NAMES)]
-    integrator: String,
+    /// Integration step, s (default: the integrator's own, 0.5 ms linearly implicit, 0.2 ms
+    /// semi-implicit or Heun).
+    #[arg(long)]
+    dt: Option<f64>,
+    /// Integrator (default: linearly-implicit): `linearly-implicit` (the wheel–rail damping,
+    /// each wheelset with its rail masses, taken implicitly: accurate at 0.5 ms, `railforce
+    /// bench step`), `semi-implicit` (explicit in every force: 0.2 ms) or `heun` (second
+    /// order, two force evaluations a step, explicit: a reference for small steps).
+    #[arg(long, value_parser = railforce::sim::Integrator::NAMES)]
+    integrator: Option<String>,
     /// Report a derailment but keep running (default: stop with an error).
     #[arg(long)]
     keep_going: bool,
@@ -52,11 +53,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         speed_kmh: args.speed_kmh,
         duration: args.duration,
         settle: args.settle,
-        stepping: railforce::sim::Stepping {
-            integrator: railforce::sim::Integrator::parse(&args.integrator)
-                .expect("checked by clap"),
-            dt: args.dt,
-        },
+        stepping: railforce::sim::Stepping::chosen(args.integrator.as_deref(), args.dt),
         stop_on_derailment: !args.keep_going,
     };
     let cfg = super::with_flags(request.config(), "--speed-kmh, --duration, --settle, --dt")?;
@@ -85,8 +82,8 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         "speed_kmh": args.speed_kmh,
         "duration_s": args.duration,
         "settle_s": args.settle,
-        "integration_step_s": args.dt,
-        "integrator": args.integrator,
+        "integration_step_s": request.stepping.dt,
+        "integrator": request.stepping.integrator.name(),
         "sampling_rate_hz": sim.config().output_rate,
         "anti_alias": format!("8th-order Butterworth low-pass at {} Hz at the integration rate, then decimation", sim.config().cutoff),
         "frame": "track frame: x along the running direction, y to the left, z up",
@@ -128,7 +125,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         args.settle,
         summary.wall,
         summary.real_time_factor,
-        args.dt * 1e3
+        request.stepping.dt * 1e3
     );
     print!("peak |Y/Q|:");
     for (k, p) in summary.peak_y_over_q.iter().enumerate() {

@@ -285,8 +285,9 @@ pub fn generate(
                 "semi-implicit Euler, fixed step (src/sim/mod.rs)".into()
             }
             crate::sim::Integrator::LinearlyImplicit => {
-                "linearly implicit: semi-implicit Euler with the wheel–rail damping at the step's \
-                 midpoint and the rail masses implicit, fixed step (src/sim/integrator.rs)"
+                "linearly implicit: semi-implicit Euler with each wheelset and its two rail masses \
+                 solved together in the wheel–rail damping at the step's midpoint, the rails' \
+                 support implicit, fixed step (src/sim/integrator.rs)"
                     .into()
             }
             crate::sim::Integrator::Heun => {

@@ -1,5 +1,5 @@
 //! One step of the bodies' motion: semi-implicit Euler (the default), or the same with the
-//! wheel–rail damping taken implicitly (linearly implicit, issue 37).
+//! wheel–rail damping taken implicitly (linearly implicit, issue 37), or Heun's method.
 //!
 //! Creep acts on a wheelset as a damper of `c ≈ f/V` (Kalker's coefficients over the speed):
 //! at 40–60 km/h its time constant is about a millisecond, so an explicit step must stay far
@@ -8,25 +8,48 @@
 //! change `Δu = (Δv, Δω)`, with `D` the contact's damping linearised by Kalker's linear theory
 //! at the law's saturation ([`crate::contact::patch_damping`]): the damping's share is taken at the
 //! step's midpoint (the trapezoidal rule: second order in it and without numerical damping;
-//! at ½ it was 2–3 times closer to the fine-step statistics than at 1, fully implicit, at
-//! 40–80 km/h and 0.4 ms, but it loses stability at 0.6 ms). The creep forces themselves stay
-//! the law's. With `D = 0` it is the explicit step. The rail masses, the stiffest mode of a
-//! compliant track on the Hertz spring, are moved implicitly in their support and in the
-//! contact's stiffness and damping (`sim/wheel_rail.rs`); the wheelset's own Hertz spring
-//! stays explicit (taken implicitly it damped the in-band vertical response: Q's standard
-//! deviation 4 % off at 0.4 ms against 0.2 %).
+//! at ½ it was 2–3 times closer to the fine-step statistics than at 1, fully implicit). The
+//! creep forces themselves stay the law's. With `D = 0` it is the explicit step.
+//!
+//! On a compliant track the same damper joins the wheel to its rail mass (the rail's velocity
+//! enters the creepage): each wheelset and its two rail masses are solved together, 10
+//! unknowns, with the shared damper at θ = ½ on both sides and the rails' support implicit.
+//! Solved apart, at 0.6 ms and 40 km/h, the statistics were 3.2 % off against 0.16 %. The
+//! contact's Hertz spring stays explicit on the rail as on the wheelset: taken implicitly
+//! (backward Euler on the rail mass on the Hertz spring, about 400 Hz) it took that mode's
+//! energy out every step, a first-order error of 0.64 / 1.31 / 2.56 % in the trailing wheels'
+//! Y/Q rms at 0.1 / 0.2 / 0.4 ms (R 400 m, 80 km/h; 0.22 % at 0.4 ms explicit). Explicit, it
+//! sets the step's limit: ω·Δt < 2 with ω = √((k_H + k_s)/m_rail) ≈ 2 500 rad/s, 0.79 ms
+//! (runs at 0.8 ms diverge, measured).
 
 use super::Simulation;
-use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
+use nalgebra::{
+    Matrix2, Matrix3, Matrix6, SMatrix, SVector, UnitQuaternion, Vector2, Vector3, Vector6,
+};
+
+/// Share of the contact damping taken at the step's end, on the wheelset and its rails alike
+/// (the trapezoidal rule; see the module's comment).
+const THETA: f64 = 0.5;
+
+/// Mass, support stiffness and support damping of a rail mass, lateral and vertical.
+fn rail_matrices(sup: &crate::track::RailSupport) -> (Matrix2<f64>, Matrix2<f64>, Matrix2<f64>) {
+    (
+        Matrix2::from_diagonal(&Vector2::new(sup.lateral.mass, sup.vertical.mass)),
+        Matrix2::from_diagonal(&Vector2::new(sup.lateral.stiffness, sup.vertical.stiffness)),
+        Matrix2::from_diagonal(&Vector2::new(sup.lateral.damping, sup.vertical.damping)),
+    )
+}
 
 /// How the bodies are integrated over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Integrator {
-    /// Semi-implicit (symplectic) Euler: velocities first, positions with the new velocities.
-    #[default]
+    /// Semi-implicit (symplectic) Euler: velocities first, positions with the new velocities
+    /// (the default until 2026-12-04, at 0.2 ms).
     SemiImplicit,
-    /// Semi-implicit Euler with each wheelset's velocity change taken implicitly in the
-    /// linearised wheel–rail damping (creep and normal).
+    /// Semi-implicit Euler with each wheelset's velocity change, and its rail masses', taken
+    /// implicitly in the linearised wheel–rail damping (creep and normal): the default, at
+    /// 0.5 ms.
+    #[default]
     LinearlyImplicit,
     /// Heun's method (explicit trapezoidal, second order): two force evaluations a step, the
     /// friction sliders and the haul's integral advanced at the accepted state only.
@@ -44,6 +67,16 @@ impl Integrator {
             "linearly-implicit" => Some(Integrator::LinearlyImplicit),
             "heun" => Some(Integrator::Heun),
             _ => None,
+        }
+    }
+
+    /// The step a run takes with it when none is given, s: the largest whose statistics stay
+    /// within 1 % of the semi-implicit step at 0.05 ms on every paper34 condition (`bench
+    /// step`; README, "Speed"), and a whole number of steps per 200 Hz output sample.
+    pub fn default_step(self) -> f64 {
+        match self {
+            Integrator::SemiImplicit | Integrator::Heun => 2e-4,
+            Integrator::LinearlyImplicit => 5e-4,
         }
     }
 
@@ -66,6 +99,18 @@ pub struct Stepping {
     pub dt: f64,
 }
 
+impl Stepping {
+    /// The integrator named (checked against [`Integrator::NAMES`]; the default where none or
+    /// an unknown one is named) at step `dt`, or at the integrator's own step.
+    pub fn chosen(integrator: Option<&str>, dt: Option<f64>) -> Self {
+        let integrator = integrator.and_then(Integrator::parse).unwrap_or_default();
+        Stepping {
+            integrator,
+            dt: dt.unwrap_or(integrator.default_step()),
+        }
+    }
+}
+
 impl Default for Stepping {
     /// The default run's: semi-implicit Euler at 0.2 ms.
     fn default() -> Self {
@@ -82,17 +127,18 @@ impl Simulation<'_> {
     pub(super) fn integrate(&mut self) {
         let dt = self.cfg.dt;
         let wheelsets = &self.vehicle.contact.wheelsets;
+        let support = self.track.spec().rail_support;
+        let (rails, coupling, rail_force) =
+            (&mut self.rails, &self.rail_coupling, &self.rail_force);
         for (i, (st, w)) in self.states.iter_mut().zip(&self.wrenches).enumerate() {
             let b = &self.vehicle.bodies[i];
             let (acc, wb, dwb) = body_rates(b, st, w);
             let rot = st.rotation;
-            let damping = match self.cfg.integrator {
+            let wheelset = match self.cfg.integrator {
                 Integrator::SemiImplicit | Integrator::Heun => None,
-                Integrator::LinearlyImplicit => wheelsets
-                    .iter()
-                    .position(|&ws| ws == i)
-                    .map(|k| &self.contact_damping[k]),
+                Integrator::LinearlyImplicit => wheelsets.iter().position(|&ws| ws == i),
             };
+            let damping = wheelset.map(|k| &self.contact_damping[k]);
             let Some(d) = damping else {
                 self.accelerations[i] = acc;
                 st.velocity += acc * dt;
@@ -102,7 +148,8 @@ impl Simulation<'_> {
                 st.rotation = rot * UnitQuaternion::from_scaled_axis(wb * dt);
                 continue;
             };
-            // The explicit change, then (I + ½Δt·M⁻¹·D)·Δu = Δu_explicit.
+            // The explicit change, then (I + ½Δt·M⁻¹·D)·Δu = Δu_explicit, with the wheelset's
+            // two rail masses in the same solve on a compliant track.
             let dw_explicit = rot * (wb + dwb * dt) - st.angular_velocity;
             let r = rot.to_rotation_matrix().into_inner();
             let inv_inertia =
@@ -115,25 +162,68 @@ impl Simulation<'_> {
                 dw_explicit.y,
                 dw_explicit.z,
             );
-            let mut a = d * (0.5 * dt);
-            for row in 0..3 {
-                for col in 0..6 {
-                    a[(row, col)] /= b.mass;
+            // M⁻¹ on a wrench's rows.
+            let inv_mass = |m: &mut nalgebra::SMatrix<f64, 6, 6>| {
+                for row in 0..3 {
+                    for col in 0..6 {
+                        m[(row, col)] /= b.mass;
+                    }
                 }
-            }
-            let top: Matrix3<f64> = a
-                .fixed_view::<3, 6>(3, 0)
-                .fixed_columns::<3>(0)
-                .into_owned();
-            let rest: Matrix3<f64> = a
-                .fixed_view::<3, 6>(3, 0)
-                .fixed_columns::<3>(3)
-                .into_owned();
-            a.fixed_view_mut::<3, 3>(3, 0)
-                .copy_from(&(inv_inertia * top));
-            a.fixed_view_mut::<3, 3>(3, 3)
-                .copy_from(&(inv_inertia * rest));
-            let du = (Matrix6::identity() + a).lu().solve(&du).unwrap_or(du);
+                let top: Matrix3<f64> = m.fixed_view::<3, 3>(3, 0).into_owned();
+                let rest: Matrix3<f64> = m.fixed_view::<3, 3>(3, 3).into_owned();
+                m.fixed_view_mut::<3, 3>(3, 0)
+                    .copy_from(&(inv_inertia * top));
+                m.fixed_view_mut::<3, 3>(3, 3)
+                    .copy_from(&(inv_inertia * rest));
+            };
+            let mut a = d * (THETA * dt);
+            inv_mass(&mut a);
+            let k = wheelset.expect("a damped body is a wheelset");
+            let du = match support {
+                None => (Matrix6::identity() + a).lu().solve(&du).unwrap_or(du),
+                Some(sup) => {
+                    let (m, ks, cs) = rail_matrices(&sup);
+                    let mut big = SMatrix::<f64, 10, 10>::identity();
+                    let mut rhs = SVector::<f64, 10>::zeros();
+                    big.fixed_view_mut::<6, 6>(0, 0)
+                        .copy_from(&(Matrix6::identity() + a));
+                    rhs.fixed_rows_mut::<6>(0).copy_from(&du);
+                    for side in 0..2 {
+                        let idx = 2 * k + side;
+                        let (rail, c, f) = (&rails[idx], &coupling[idx], rail_force[idx]);
+                        let row = 6 + 2 * side;
+                        // Wheelset rows: −θΔt·M⁻¹·D_k·P·Δr_k.
+                        let mut cross = SMatrix::<f64, 6, 6>::zeros();
+                        cross
+                            .fixed_columns_mut::<2>(0)
+                            .copy_from(&(-c.from_rail * (THETA * dt)));
+                        inv_mass(&mut cross);
+                        big.fixed_view_mut::<6, 2>(0, row)
+                            .copy_from(&cross.fixed_columns::<2>(0));
+                        // Rail rows, implicit in the support and in the contact's damping
+                        // (the damper it shares with the wheelset, θ on both sides):
+                        // (M + Δt·(θ·C_c + C_s) + Δt²·K_s)·Δr − θΔt·Pᵀ·D_k·Δu
+                        //   = Δt·(R − K_s·(x + Δt·v) − C_s·v).
+                        let (x, v) = (Vector2::new(rail.y, rail.z), Vector2::new(rail.vy, rail.vz));
+                        let lhs = m + (c.damping * THETA + cs) * dt + ks * (dt * dt);
+                        big.fixed_view_mut::<2, 2>(row, row).copy_from(&lhs);
+                        big.fixed_view_mut::<2, 6>(row, 0)
+                            .copy_from(&(-c.to_rail * (THETA * dt)));
+                        let r = (Vector2::from(f) - ks * (x + v * dt) - cs * v) * dt;
+                        rhs.fixed_rows_mut::<2>(row).copy_from(&r);
+                    }
+                    let sol = big.lu().solve(&rhs).unwrap_or(rhs);
+                    for side in 0..2 {
+                        let rail = &mut rails[2 * k + side];
+                        let dv = sol.fixed_rows::<2>(6 + 2 * side);
+                        rail.vy += dv.x;
+                        rail.vz += dv.y;
+                        rail.y += rail.vy * dt;
+                        rail.z += rail.vz * dt;
+                    }
+                    sol.fixed_rows::<6>(0).into_owned()
+                }
+            };
             let dv = du.fixed_rows::<3>(0).into_owned();
             self.accelerations[i] = dv / dt;
             st.velocity += dv;

@@ -85,7 +85,7 @@ impl Default for SimConfig {
             speed: 60.0 / 3.6,
             duration: 10.0,
             settle: 3.0,
-            dt: 2e-4,
+            dt: Integrator::default().default_step(),
             output_rate: 200.0,
             cutoff: 50.0,
             start: None,
@@ -97,7 +97,7 @@ impl Default for SimConfig {
             lateral_limit: 39e-3,
             runaway_speed: 20.0,
             initial_offset: 0.0,
-            integrator: Integrator::SemiImplicit,
+            integrator: Integrator::default(),
         }
     }
 }

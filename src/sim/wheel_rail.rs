@@ -53,14 +53,19 @@ pub struct RailState {
     pub vz: f64,
 }
 
-/// What the contact does to the rail's lateral and vertical motion under one wheel, linearised
-/// (track axes; the linearly implicit step's): damping, normal stiffness, and the growth rate
-/// of the wheel's elastic push on the rail at the present approach.
+/// The contact's damping between one wheel and its rail mass, linearised (the linearly
+/// implicit step's): on the rail's lateral and vertical motion (track axes), and across to the
+/// wheelset's.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(super) struct RailCoupling {
+    /// On the rail's own motion (`Pᵀ·D_k·P`), track axes.
     pub damping: nalgebra::Matrix2<f64>,
-    pub stiffness: nalgebra::Matrix2<f64>,
-    pub approach: nalgebra::Vector2<f64>,
+    /// How the wheelset's velocity change (world `Δv, Δω`) pushes the rail through this
+    /// wheel's damping: rows `y, z` (track) of `D_k` (`Pᵀ·D_k`).
+    pub to_rail: nalgebra::SMatrix<f64, 2, 6>,
+    /// How the rail's velocity change (track `Δy, Δz`) pushes the wheelset through it
+    /// (`D_k·P`, world wrench).
+    pub from_rail: nalgebra::SMatrix<f64, 6, 2>,
 }
 
 impl Simulation<'_> {
@@ -131,16 +136,33 @@ impl Simulation<'_> {
                 self.inputs[idx] = wr;
                 if implicit {
                     let mut rail = RailCoupling::default();
+                    let mut wheel = nalgebra::Matrix6::zeros();
                     for p in out.patches.iter().flatten() {
                         let d = crate::contact::patch_damping(p, &model, wr.speed);
-                        damping += d;
-                        // The rail moves under the wheel's relative velocity and approach:
-                        // its reaction has the same damping, and the patch's normal stiffness.
+                        wheel += d;
+                        // The rail moves under the wheel's relative velocity: its reaction
+                        // has the same damping.
                         rail.damping += d.fixed_view::<2, 2>(1, 1);
-                        let n = nalgebra::Vector2::new(p.frame.n[1], p.frame.n[2]);
-                        rail.stiffness += n * n.transpose() * p.stiffness;
-                        rail.approach += n * (p.stiffness * p.approach_rate);
                     }
+                    // The rail's velocity enters the wheel's relative velocity as minus a
+                    // wheelset translation along track y and z (`wheels_on_rails`), so
+                    // P = [A·e_y, A·e_z; 0, 0] maps it to the wheelset's coordinates.
+                    let a = f.axes;
+                    for j in 0..2 {
+                        let col = wheel.column(1 + j).into_owned();
+                        rail.from_rail
+                            .fixed_view_mut::<3, 1>(0, j)
+                            .copy_from(&(a * col.fixed_rows::<3>(0)));
+                        rail.from_rail
+                            .fixed_view_mut::<3, 1>(3, j)
+                            .copy_from(&(a * col.fixed_rows::<3>(3)));
+                        let row = wheel.row(1 + j);
+                        let lin = row.fixed_columns::<3>(0) * a.transpose();
+                        let ang = row.fixed_columns::<3>(3) * a.transpose();
+                        rail.to_rail.fixed_view_mut::<1, 3>(j, 0).copy_from(&lin);
+                        rail.to_rail.fixed_view_mut::<1, 3>(j, 3).copy_from(&ang);
+                    }
+                    damping += wheel;
                     self.rail_coupling[idx] = rail;
                 }
                 let force = f.axes * Vector3::from(out.force);
@@ -187,39 +209,14 @@ impl Simulation<'_> {
         Ok(())
     }
 
-    /// Moves the rail masses one step under the wheels' reactions (compliant track only).
+    /// Moves the rail masses one step under the wheels' reactions (compliant track only; the
+    /// linearly implicit step moves them with their wheelset in `integrate`).
     pub(super) fn move_rails(&mut self) {
         let Some(sup) = self.track.spec().rail_support else {
             return;
         };
         let dt = self.cfg.dt;
         if self.cfg.integrator == super::Integrator::LinearlyImplicit {
-            // Implicit in the support and in the contact's stiffness and damping on the rail
-            // (the rail mass on the Hertz spring is the stiffest mode of a compliant track):
-            // (M + Δt·(C_c + C_s) + Δt²·(K_c + K_s))·Δv
-            //     = Δt·(R − Δt·k_n·ṙ·n − K_s·(x + Δt·v) − C_s·v).
-            use nalgebra::{Matrix2, Vector2};
-            let m = Matrix2::from_diagonal(&Vector2::new(sup.lateral.mass, sup.vertical.mass));
-            let ks = Matrix2::from_diagonal(&Vector2::new(
-                sup.lateral.stiffness,
-                sup.vertical.stiffness,
-            ));
-            let cs =
-                Matrix2::from_diagonal(&Vector2::new(sup.lateral.damping, sup.vertical.damping));
-            for ((r, f), c) in self
-                .rails
-                .iter_mut()
-                .zip(&self.rail_force)
-                .zip(&self.rail_coupling)
-            {
-                let (x, v) = (Vector2::new(r.y, r.z), Vector2::new(r.vy, r.vz));
-                let a = m + (c.damping + cs) * dt + (c.stiffness + ks) * (dt * dt);
-                let rhs = (Vector2::from(*f) - c.approach * dt - ks * (x + v * dt) - cs * v) * dt;
-                let dv = a.lu().solve(&rhs).unwrap_or_else(Vector2::zeros);
-                (r.vy, r.vz) = (v.x + dv.x, v.y + dv.y);
-                r.y += r.vy * dt;
-                r.z += r.vz * dt;
-            }
             return;
         }
         for (r, f) in self.rails.iter_mut().zip(&self.rail_force) {

@@ -65,10 +65,10 @@ enum What {
         /// Simulated seconds per measurement.
         #[arg(long, default_value_t = 20.0)]
         seconds: f64,
-        /// Integrator (`bench step` measures what each costs in accuracy).
-        #[arg(long, default_value = "semi-implicit", value_parser = railforce::sim::Integrator::NAMES)]
-        integrator: String,
-        /// Integration step, s (default: the default step).
+        /// Integrator (default: the default; `bench step` measures what each costs in accuracy).
+        #[arg(long, value_parser = railforce::sim::Integrator::NAMES)]
+        integrator: Option<String>,
+        /// Integration step, s (default: the integrator's own).
         #[arg(long)]
         dt: Option<f64>,
     },
@@ -176,10 +176,10 @@ pub fn run(args: BenchArgs) -> Result<()> {
             let table_s = t0.elapsed().as_secs_f64();
             let tr = railforce::track::Track::load(&super::builtin::resolve(&track)?)?;
             let default = railforce::sim::SimConfig::default();
+            let stepping = railforce::sim::Stepping::chosen(integrator.as_deref(), dt);
             let base = railforce::sim::SimConfig {
-                integrator: railforce::sim::Integrator::parse(&integrator)
-                    .expect("checked by clap"),
-                dt: dt.unwrap_or(default.dt),
+                integrator: stepping.integrator,
+                dt: stepping.dt,
                 ..default.clone()
             };
             let b = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, &base)?;
