@@ -1,8 +1,9 @@
 //! Time-domain simulation of a vehicle on a track.
 //!
-//! Rigid bodies in the world frame (x, y horizontal, z up), integrated by semi-implicit Euler
-//! with a fixed step (default 0.2 ms: stable for the stiffest contact and creep terms, and the
-//! same curving means as 0.1 ms to 0.01 %), gyroscopic terms included (wheelsets spin).
+//! Rigid bodies in the world frame (x, y horizontal, z up), integrated at a fixed step (default:
+//! linearly implicit in the wheel–rail damping at 0.5 ms, each wheelset solved with its rail
+//! masses; semi-implicit Euler at 0.2 ms selectable: `integrator`), gyroscopic terms included
+//! (wheelsets spin).
 //! Every step the project computes all force elements and the wheel–rail contact from the body
 //! states and the track (curvature, cant, gradient, irregularities under each wheel). Signals
 //! are low-pass filtered at the integration rate and decimated to the output rate.

@@ -103,14 +103,14 @@ impl RailSupport {
                 )?,
             },
         };
-        // The explicit step must resolve the rail on its own springs with margin.
+        // The semi-implicit step must resolve the rail on its own springs with margin.
         for (name, s) in [("lateral", support.lateral), ("vertical", support.vertical)] {
             if s.natural_frequency() > 400.0 {
                 return Err(Error::config(
                     path,
                     format!("rail_support.{name}_mass_kg"),
                     format!(
-                        "the {name} rail mass on its spring rings at {:.0} Hz, above the 400 Hz the 0.2 ms step resolves: use more mass or less stiffness",
+                        "the {name} rail mass on its spring rings at {:.0} Hz, above the 400 Hz the semi-implicit 0.2 ms step resolves: use more mass or less stiffness",
                         s.natural_frequency()
                     ),
                 ));
