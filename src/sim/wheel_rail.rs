@@ -68,6 +68,35 @@ pub(super) struct RailCoupling {
     pub from_rail: nalgebra::SMatrix<f64, 6, 2>,
 }
 
+impl RailCoupling {
+    /// The coupling of one wheel's damping `d` (track axes, about the wheelset's centre, as
+    /// [`crate::contact::patch_damping`] sums it) with its rail, the track's axes `a` (track
+    /// to world). The rail's velocity enters the wheel's relative velocity as minus a
+    /// wheelset translation along track y and z (`wheels_on_rails`), so
+    /// `P = [A·e_y, A·e_z; 0, 0]` maps it to the wheelset's world coordinates.
+    pub(super) fn new(d: &nalgebra::Matrix6<f64>, a: &nalgebra::Matrix3<f64>) -> Self {
+        let mut c = RailCoupling {
+            damping: d.fixed_view::<2, 2>(1, 1).into_owned(),
+            ..RailCoupling::default()
+        };
+        for j in 0..2 {
+            let col = d.column(1 + j).into_owned();
+            c.from_rail
+                .fixed_view_mut::<3, 1>(0, j)
+                .copy_from(&(a * col.fixed_rows::<3>(0)));
+            c.from_rail
+                .fixed_view_mut::<3, 1>(3, j)
+                .copy_from(&(a * col.fixed_rows::<3>(3)));
+            let row = d.row(1 + j);
+            let lin = row.fixed_columns::<3>(0) * a.transpose();
+            let ang = row.fixed_columns::<3>(3) * a.transpose();
+            c.to_rail.fixed_view_mut::<1, 3>(j, 0).copy_from(&lin);
+            c.to_rail.fixed_view_mut::<1, 3>(j, 3).copy_from(&ang);
+        }
+        c
+    }
+}
+
 impl Simulation<'_> {
     /// What the last step gave the contact evaluation for each wheel (1L, 1R, 2L, …).
     pub fn contact_inputs(&self) -> &[WheelOnRail] {
@@ -135,35 +164,12 @@ impl Simulation<'_> {
                 );
                 self.inputs[idx] = wr;
                 if implicit {
-                    let mut rail = RailCoupling::default();
                     let mut wheel = nalgebra::Matrix6::zeros();
                     for p in out.patches.iter().flatten() {
-                        let d = crate::contact::patch_damping(p, &model, wr.speed);
-                        wheel += d;
-                        // The rail moves under the wheel's relative velocity: its reaction
-                        // has the same damping.
-                        rail.damping += d.fixed_view::<2, 2>(1, 1);
+                        wheel += crate::contact::patch_damping(p, &model, wr.speed);
                     }
-                    // The rail's velocity enters the wheel's relative velocity as minus a
-                    // wheelset translation along track y and z (`wheels_on_rails`), so
-                    // P = [A·e_y, A·e_z; 0, 0] maps it to the wheelset's coordinates.
-                    let a = f.axes;
-                    for j in 0..2 {
-                        let col = wheel.column(1 + j).into_owned();
-                        rail.from_rail
-                            .fixed_view_mut::<3, 1>(0, j)
-                            .copy_from(&(a * col.fixed_rows::<3>(0)));
-                        rail.from_rail
-                            .fixed_view_mut::<3, 1>(3, j)
-                            .copy_from(&(a * col.fixed_rows::<3>(3)));
-                        let row = wheel.row(1 + j);
-                        let lin = row.fixed_columns::<3>(0) * a.transpose();
-                        let ang = row.fixed_columns::<3>(3) * a.transpose();
-                        rail.to_rail.fixed_view_mut::<1, 3>(j, 0).copy_from(&lin);
-                        rail.to_rail.fixed_view_mut::<1, 3>(j, 3).copy_from(&ang);
-                    }
+                    self.rail_coupling[idx] = RailCoupling::new(&wheel, &f.axes);
                     damping += wheel;
-                    self.rail_coupling[idx] = rail;
                 }
                 let force = f.axes * Vector3::from(out.force);
                 self.wrenches[b].force += force;
