@@ -24,9 +24,7 @@
 
 use super::Simulation;
 use super::wheel_rail::{RailCoupling, RailState};
-use nalgebra::{
-    Matrix2, Matrix3, Matrix6, SMatrix, SVector, UnitQuaternion, Vector2, Vector3, Vector6,
-};
+use nalgebra::{Matrix2, Matrix3, Matrix6, SMatrix, UnitQuaternion, Vector2, Vector3, Vector6};
 
 /// Share of the contact damping taken at the step's end, on the wheelset and its rails alike
 /// (the trapezoidal rule; see the module's comment).
@@ -251,38 +249,42 @@ fn with_rails(
     let (m, ks, cs) = rail_matrices(sup);
     let mut a = d * (THETA * dt);
     body.apply(&mut a);
-    let mut big = SMatrix::<f64, 10, 10>::identity();
-    let mut rhs = SVector::<f64, 10>::zeros();
-    big.fixed_view_mut::<6, 6>(0, 0)
-        .copy_from(&(Matrix6::identity() + a));
-    rhs.fixed_rows_mut::<6>(0).copy_from(&du);
+    // The rails' rows eliminated (a Schur complement: each rail's block is 2×2), so the
+    // solve is the wheelset's 6×6: Δr_k = L_k⁻¹·(r_k − Y_k·Δu),
+    // (I + A − Σ X_k·L_k⁻¹·Y_k)·Δu = Δu_explicit − Σ X_k·L_k⁻¹·r_k.
+    let mut lhs6 = Matrix6::identity() + a;
+    let mut rhs6 = du;
+    let mut parts = [(
+        Matrix2::zeros(),
+        SMatrix::<f64, 2, 6>::zeros(),
+        Vector2::zeros(),
+    ); 2];
     for side in 0..2 {
         let (rail, c, f) = (&rails[side], &coupling[side], rail_force[side]);
-        let row = 6 + 2 * side;
         let mut cross = Matrix6::zeros();
         cross
             .fixed_columns_mut::<2>(0)
             .copy_from(&(-c.from_rail * (THETA * dt)));
         body.apply(&mut cross);
-        big.fixed_view_mut::<6, 2>(0, row)
-            .copy_from(&cross.fixed_columns::<2>(0));
-        let (x, v) = (Vector2::new(rail.y, rail.z), Vector2::new(rail.vy, rail.vz));
-        let lhs = m + (c.damping * THETA + cs) * dt + ks * (dt * dt);
-        big.fixed_view_mut::<2, 2>(row, row).copy_from(&lhs);
-        big.fixed_view_mut::<2, 6>(row, 0)
-            .copy_from(&(-c.to_rail * (THETA * dt)));
-        let r = (Vector2::from(f) - ks * (x + v * dt) - cs * v) * dt;
-        rhs.fixed_rows_mut::<2>(row).copy_from(&r);
+        let x: SMatrix<f64, 6, 2> = cross.fixed_columns::<2>(0).into_owned();
+        let y = -c.to_rail * (THETA * dt);
+        let (xv, vv) = (Vector2::new(rail.y, rail.z), Vector2::new(rail.vy, rail.vz));
+        let l = m + (c.damping * THETA + cs) * dt + ks * (dt * dt);
+        let r = (Vector2::from(f) - ks * (xv + vv * dt) - cs * vv) * dt;
+        let l_inv = l.try_inverse().unwrap_or_else(Matrix2::zeros);
+        lhs6 -= x * (l_inv * y);
+        rhs6 -= x * (l_inv * r);
+        parts[side] = (l_inv, y, r);
     }
-    let sol = big.lu().solve(&rhs).unwrap_or(rhs);
-    for (side, rail) in rails.iter_mut().enumerate() {
-        let dv = sol.fixed_rows::<2>(6 + 2 * side);
+    let du = lhs6.lu().solve(&rhs6).unwrap_or(rhs6);
+    for (rail, (l_inv, y, r)) in rails.iter_mut().zip(parts) {
+        let dv = l_inv * (r - y * du);
         rail.vy += dv.x;
         rail.vz += dv.y;
         rail.y += rail.vy * dt;
         rail.z += rail.vz * dt;
     }
-    sol.fixed_rows::<6>(0).into_owned()
+    du
 }
 
 /// A body's rates under its wrench: linear acceleration (world), angular velocity and angular
