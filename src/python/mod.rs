@@ -40,13 +40,17 @@ pub(crate) fn resolve(path: &Path) -> PyResult<PathBuf> {
     builtin::resolve(path).map_err(py_err)
 }
 
-fn integrator(name: &str) -> PyResult<Integrator> {
-    Integrator::parse(name).ok_or_else(|| {
-        PyValueError::new_err(format!(
+/// The integrator named (default: the library's) at step `dt` (default: its own step).
+fn stepping(name: Option<&str>, dt: Option<f64>) -> PyResult<Stepping> {
+    if let Some(name) = name
+        && Integrator::parse(name).is_none()
+    {
+        return Err(PyValueError::new_err(format!(
             "integrator {name}: one of {}",
             Integrator::NAMES.join(", ")
-        ))
-    })
+        )));
+    }
+    Ok(Stepping::chosen(name, dt))
 }
 
 /// Columns given from Python (name, float64 array) as the library's columns.
@@ -82,18 +86,15 @@ fn simulate<'py>(
     seed: Option<u64>,
     channels: Option<Vec<String>>,
     settle_s: f64,
-    dt: f64,
-    integrator: &str,
+    dt: Option<f64>,
+    integrator: Option<&str>,
     keep_going: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = RunRequest {
         speed_kmh,
         duration: duration_s,
         settle: settle_s,
-        stepping: Stepping {
-            integrator: self::integrator(integrator)?,
-            dt,
-        },
+        stepping: stepping(integrator, dt)?,
         stop_on_derailment: !keep_going,
     };
     let cfg = request.config().map_err(py_err)?;
@@ -146,8 +147,8 @@ fn generate(
     snr_db: Option<f64>,
     snr_reference: &str,
     settle_s: f64,
-    integrator: &str,
-    dt: f64,
+    integrator: Option<&str>,
+    dt: Option<f64>,
 ) -> PyResult<String> {
     let plan = Plan::load(&resolve(&plan)?).map_err(py_err)?;
     let format = Format::parse(format).ok_or_else(|| {
@@ -174,10 +175,7 @@ fn generate(
         shard,
         noise,
         settle: settle_s,
-        stepping: Stepping {
-            integrator: self::integrator(integrator)?,
-            dt,
-        },
+        stepping: stepping(integrator, dt)?,
     };
     let m = py
         .detach(|| dataset::generate(&plan, &opts, &|_| {}))

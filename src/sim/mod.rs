@@ -397,8 +397,8 @@ impl<'a> Simulation<'a> {
     /// let cfg = SimConfig { speed: 60.0 / 3.6, ..SimConfig::default() };
     /// let mut sim = Simulation::new(&vehicle, &track, cfg)?;
     /// sim.settle()?;
-    /// for _ in 0..5_000 {
-    ///     sim.step()?; // 1 s at the 0.2 ms step
+    /// for _ in 0..2_000 {
+    ///     sim.step()?; // 1 s at the default 0.5 ms step
     /// }
     /// println!("Q of wheel 1L: {:.1} kN", sim.wheels[0].q / 1e3);
     /// # Ok::<(), railforce::Error>(())
