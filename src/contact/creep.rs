@@ -73,14 +73,19 @@ impl CreepLaw {
 
     /// Creep forces for the creepages at a contact.
     pub fn force(&self, c: &CreepContact, s: Creepage) -> CreepForce {
+        self.force_with(c, &KalkerCoefficients::new(c.a / c.b, c.poisson), s)
+    }
+
+    /// [`Self::force`] with Kalker's coefficients of the contact's ellipse given (the caller
+    /// computed them once for this and the step's linearisation).
+    pub fn force_with(&self, c: &CreepContact, k: &KalkerCoefficients, s: Creepage) -> CreepForce {
         if c.normal <= 0.0 || c.a <= 0.0 || c.b <= 0.0 {
             return CreepForce::default();
         }
-        let k = KalkerCoefficients::new(c.a / c.b, c.poisson);
         match self {
-            CreepLaw::Linear => linear(c, &k, s),
-            CreepLaw::Polach => polach(c, &k, s),
-            CreepLaw::Fastsim { n } => fastsim(c, &k, s, *n),
+            CreepLaw::Linear => linear(c, k, s),
+            CreepLaw::Polach => polach(c, k, s),
+            CreepLaw::Fastsim { n } => fastsim(c, k, s, *n),
         }
     }
 }

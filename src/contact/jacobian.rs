@@ -12,7 +12,6 @@
 //! 0.2–0.4 ms (`bench step`, R 400 m at 40 and 60 km/h) and made the step about 8 µs dearer;
 //! so the secant.
 
-use super::KalkerCoefficients;
 use super::wheel_rail::{ContactModel, PatchForce};
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
@@ -35,7 +34,7 @@ pub fn patch_damping(p: &PatchForce, model: &ContactModel, speed: f64) -> Matrix
     let mut c = n * n.transpose() * p.damping;
     let mut spin = Matrix3::zeros();
     if a > 0.0 && b > 0.0 && p.normal > 0.0 {
-        let k = KalkerCoefficients::new(a / b, model.material.poisson);
+        let k = p.kalker;
         let gab = model.material.shear_modulus() * a * b;
         let s = p.creepage;
         let linear =

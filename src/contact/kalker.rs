@@ -161,11 +161,42 @@ const TABLE_AB_GT_1: [Row; 9] = [
     ),
 ];
 
-/// Value at Poisson ratio ν from the three tabulated values (interpolation of 1/C, assets/docs/physics.md §4).
-fn in_nu(c: [f64; 3], nu: f64) -> f64 {
-    let inv = 8.0 * (nu - 0.25) * (nu - 0.5) / c[0] - 16.0 * nu * (nu - 0.5) / c[1]
-        + 8.0 * nu * (nu - 0.25) / c[2];
-    1.0 / inv
+/// A table with every coefficient replaced by its reciprocal (the interpolation in ν is of
+/// `1/C`), at compile time: a coefficient then costs one division instead of four.
+const fn reciprocals<const N: usize>(table: [Row; N]) -> [Row; N] {
+    let mut out = table;
+    let mut i = 0;
+    while i < N {
+        let mut v = 0;
+        while v < 3 {
+            out[i].1[v] = 1.0 / table[i].1[v];
+            out[i].2[v] = 1.0 / table[i].2[v];
+            out[i].3[v] = 1.0 / table[i].3[v];
+            out[i].4[v] = 1.0 / table[i].4[v];
+            v += 1;
+        }
+        i += 1;
+    }
+    out
+}
+
+/// `TABLE_AB_LE_1` and `TABLE_AB_GT_1` as reciprocals.
+const INV_AB_LE_1: [Row; 10] = reciprocals(TABLE_AB_LE_1);
+/// See [`INV_AB_LE_1`].
+const INV_AB_GT_1: [Row; 9] = reciprocals(TABLE_AB_GT_1);
+
+/// Weights of `1/C(0)`, `1/C(¼)`, `1/C(½)` at Poisson ratio ν (assets/docs/physics.md §4).
+fn nu_weights(nu: f64) -> [f64; 3] {
+    [
+        8.0 * (nu - 0.25) * (nu - 0.5),
+        -16.0 * nu * (nu - 0.5),
+        8.0 * nu * (nu - 0.25),
+    ]
+}
+
+/// Value at Poisson ratio ν from the three tabulated reciprocals (interpolation of 1/C).
+fn in_nu(inv: [f64; 3], w: [f64; 3]) -> f64 {
+    1.0 / (w[0] * inv[0] + w[1] * inv[1] + w[2] * inv[2])
 }
 
 impl KalkerCoefficients {
@@ -176,11 +207,11 @@ impl KalkerCoefficients {
         // One ordered list of rows, increasing with a/b: t = a/b on the first table (0.1 … 1)
         // and t = 2 − b/a on the second (1.1 … 1.9).
         let row = |i: usize| -> (f64, [[f64; 3]; 4]) {
-            let (c11, c22, c23, c33, t) = if i < TABLE_AB_LE_1.len() {
-                let r = TABLE_AB_LE_1[i];
+            let (c11, c22, c23, c33, t) = if i < INV_AB_LE_1.len() {
+                let r = INV_AB_LE_1[i];
                 (r.1, r.2, r.3, r.4, r.0)
             } else {
-                let r = TABLE_AB_GT_1[i - TABLE_AB_LE_1.len()];
+                let r = INV_AB_GT_1[i - INV_AB_LE_1.len()];
                 (r.1, r.2, r.3, r.4, 2.0 - r.0)
             };
             (t, [c11, c22, c23, c33])
@@ -196,9 +227,10 @@ impl KalkerCoefficients {
         let (t0, v0) = row(i);
         let (t1, v1) = row(i + 1);
         let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        let weights = nu_weights(nu);
         let c = |k: usize| {
-            let a = in_nu(v0[k], nu);
-            let b = in_nu(v1[k], nu);
+            let a = in_nu(v0[k], weights);
+            let b = in_nu(v1[k], weights);
             a + w * (b - a)
         };
         KalkerCoefficients {

@@ -8,6 +8,7 @@
 use super::creep::{CreepContact, CreepForce, CreepLaw, Creepage};
 use super::geometry::Side;
 use super::hertz::{HertzEllipse, Material};
+use super::kalker::KalkerCoefficients;
 use super::table::ContactTable;
 
 /// Creepages are slip velocities over the running speed; below this speed (m/s) the speed is
@@ -89,6 +90,8 @@ pub struct PatchForce {
     pub radius: f64,
     /// Hertz ellipse under `normal`.
     pub ellipse: HertzEllipse,
+    /// Kalker's coefficients of that ellipse.
+    pub kalker: KalkerCoefficients,
     /// Creepages.
     pub creepage: Creepage,
     /// Creep forces in the contact plane, N.
@@ -156,9 +159,14 @@ impl ContactFrame {
     /// Frame of a contact with angle `angle` on `side` (positive angles tilt the normal toward
     /// the track centre… of the wheel: the flange is pushed toward the field side).
     pub fn new(side: Side, angle: f64, yaw: f64) -> Self {
+        let (sy, cy) = yaw.sin_cos();
+        Self::with_yaw(side, angle, sy, cy)
+    }
+
+    /// [`Self::new`] from the yaw's sine and cosine (both patches of a wheel share them).
+    fn with_yaw(side: Side, angle: f64, sy: f64, cy: f64) -> Self {
         let s = side.sign();
         let (sd, cd) = angle.sin_cos();
-        let (sy, cy) = yaw.sin_cos();
         ContactFrame {
             tx: [cy, sy, 0.0],
             ty: [-sy * cd, cy * cd, s * sd],
@@ -219,7 +227,7 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
         // shows up as false longitudinal creepage).
         let (y1, z1) = (cr * l.y - sr * l.z, sr * l.y + cr * l.z);
         let point = [-sy * y1, cy * y1, z1];
-        let frame = ContactFrame::new(w.side, l.angle, w.yaw);
+        let frame = ContactFrame::with_yaw(w.side, l.angle, sy, cy);
         let vc = {
             let r = cross(w.angular_velocity, point);
             [
@@ -232,7 +240,7 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
         // it), with the linearised patch stiffness and the mass behind the contact.
         let rate =
             -dot(vc, frame.n) + (w.surface_rate[0] * frame.n[1] + w.surface_rate[1] * frame.n[2]);
-        let k_n = l.stiffness / l.angle.cos().max(0.2);
+        let k_n = l.stiffness / frame.n[2].max(0.2); // n_z = cos(contact angle)
         let damping = 2.0 * model.damping_ratio * (k_n * w.mass).sqrt();
         let normal = (l.normal + damping * rate).max(0.0);
         if normal <= 0.0 {
@@ -244,7 +252,8 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
             spin: dot(w.angular_velocity, frame.n) / speed,
         };
         let ellipse = l.hertz.ellipse(normal, &model.material);
-        let creep = model.law.force(
+        let kalker = KalkerCoefficients::new(ellipse.a / ellipse.b, model.material.poisson);
+        let creep = model.law.force_with(
             &CreepContact {
                 a: ellipse.a,
                 b: ellipse.b,
@@ -253,6 +262,7 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
                 shear_modulus: model.material.shear_modulus(),
                 poisson: model.material.poisson,
             },
+            &kalker,
             creepage,
         );
         let f: [f64; 3] = std::array::from_fn(|j| {
@@ -269,6 +279,7 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
             point,
             radius: l.radius,
             ellipse,
+            kalker,
             creepage,
             creep,
             force: f,

@@ -54,6 +54,8 @@ pub struct Recorder {
     count: usize,
     row: Vec<f64>,
     paper: bool,
+    /// Each body's ten values of the step (kept to spare an allocation a step).
+    bodies: Vec<[f64; 10]>,
 }
 
 impl Recorder {
@@ -99,6 +101,7 @@ impl Recorder {
             count: 0,
             row: vec![0.0; n],
             paper,
+            bodies: Vec::with_capacity(sim.states().len()),
         }
     }
 
@@ -117,7 +120,7 @@ impl Recorder {
     pub fn sample(&mut self, sim: &mut Simulation) -> Option<&[f64]> {
         sim.refresh_frames();
         let sim = &*sim;
-        signals(sim, self.paper, &mut self.row);
+        signals(sim, self.paper, &mut self.bodies, &mut self.row);
         if self.count == 0 {
             self.filters.hold(&self.row[2..]);
         }
@@ -129,7 +132,7 @@ impl Recorder {
 }
 
 /// Computes all channels of the current step into `out` (same order as the names).
-fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
+fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &mut [f64]) {
     let v = sim.vehicle();
     let states = sim.states();
     // World z is up: a body at rest has a = 0 and reads a − g = +g·e_z as specific force.
@@ -137,16 +140,17 @@ fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
         Accelerometers::Kinematic => Vector3::zeros(),
         Accelerometers::SpecificForce => Vector3::new(0.0, 0.0, crate::GRAVITY),
     };
-    let mut body_vals: Vec<[f64; 10]> = Vec::with_capacity(states.len());
+    body_vals.clear();
     for (i, st) in states.iter().enumerate() {
         let f = &sim.frames()[i];
         let spec_force = sim.accelerations[i] + g;
         let is_ws = v.contact.wheelsets.contains(&i);
-        let axes = if is_ws { f.axes } else { st.matrix() };
+        let m = st.matrix();
+        let axes = if is_ws { f.axes } else { m };
         let a = axes.transpose() * spec_force;
         let w = axes.transpose() * st.angular_velocity;
         let rel = f.to_local(&(st.position - f.origin));
-        let rot_rel = f.axes.transpose() * st.matrix();
+        let rot_rel = f.axes.transpose() * m;
         let y_axis = rot_rel.column(1);
         body_vals.push([
             a.x,
@@ -224,7 +228,7 @@ fn signals(sim: &Simulation, paper: bool, out: &mut [f64]) {
             put(x);
         }
     }
-    for b in &body_vals {
+    for b in body_vals.iter() {
         for &x in b {
             put(x);
         }
