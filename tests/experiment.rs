@@ -49,6 +49,7 @@ fn every_experiment_runs_end_to_end() {
         snrs: vec![40.0, 1.0],
         loco: vec!["curve_r400_v60".into()],
         window: 12,
+        mismatch_window: 16,
         train: TrainOptions {
             epochs: 2,
             patience: 2,
@@ -188,6 +189,16 @@ fn every_experiment_runs_end_to_end() {
     }
     assert!(html.contains("label at the centre step"));
     assert!(html.contains("windows of 12 steps"));
+    // The mismatch part reads its own window, its nominal models trained again at it.
+    assert!(html.contains("windows of 16 steps"));
+    assert_eq!(meta["mismatch_window"], 16);
+    for m in ["nominal_paper21", "nominal_selected"] {
+        let model: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join(format!("mismatch/models/{m}/model.json"))).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(model["data"]["window"], 16, "{m}");
+    }
     let data = meta["data_fnv1a"].clone();
 
     // One part run again on its own into the same folder: the report still shows all six,
