@@ -49,9 +49,12 @@ impl TrackFrame {
 }
 
 /// Improves `s` so that the track point at `s` lies abreast of the world point `p` (Newton on
-/// the horizontal along-track offset; two steps from a close guess are plenty).
+/// the horizontal along-track offset). Newton converges quadratically here: after a correction
+/// `ds` the error left is about `κ·ds²` (κ the curvature), so a correction under 0.1 mm leaves
+/// under 10⁻¹¹ m on any curve railforce runs and ends the iteration: from the last step's `s`
+/// (a body moves 11 mm a step at 80 km/h) one evaluation of the centre line is enough.
 pub fn project(track: &Track, p: &Vector3<f64>, mut s: f64) -> f64 {
-    for _ in 0..3 {
+    for _ in 0..4 {
         let (x, y, heading, curvature) = track.centre_line(s);
         let (sh, ch) = heading.sin_cos();
         let along = (p.x - x) * ch + (p.y - y) * sh;
@@ -59,7 +62,7 @@ pub fn project(track: &Track, p: &Vector3<f64>, mut s: f64) -> f64 {
         let lateral = -(p.x - x) * sh + (p.y - y) * ch;
         let ds = along / (1.0 - curvature * lateral);
         s += ds;
-        if ds.abs() < 1e-9 {
+        if ds.abs() < 1e-4 {
             break;
         }
     }
@@ -70,6 +73,35 @@ pub fn project(track: &Track, p: &Vector3<f64>, mut s: f64) -> f64 {
 mod tests {
     use super::*;
     use nalgebra::Rotation3;
+
+    /// One Newton step from the last step's place lands within 10⁻¹⁰ m of the converged
+    /// projection, on the curve and in its spiral.
+    #[test]
+    fn a_projection_from_the_last_step_is_converged() {
+        let track = Track::load("tracks/curve_r400.toml".as_ref()).unwrap();
+        for s0 in (0..60).map(|k| 20.0 * k as f64 + 3.0) {
+            let f = TrackFrame::at(&track, s0);
+            // A point 0.3 m left of and 0.2 m above the centre line at s0.
+            let p = f.origin + f.axes * Vector3::new(0.0, 0.3, 0.2);
+            let converged = {
+                let mut s = s0 - 0.011;
+                for _ in 0..20 {
+                    let (x, y, heading, curvature) = track.centre_line(s);
+                    let (sh, ch) = heading.sin_cos();
+                    let along = (p.x - x) * ch + (p.y - y) * sh;
+                    let lateral = -(p.x - x) * sh + (p.y - y) * ch;
+                    s += along / (1.0 - curvature * lateral);
+                }
+                s
+            };
+            let s = project(&track, &p, s0 - 0.011);
+            assert!(
+                (s - converged).abs() < 1e-10,
+                "{s0}: {s} against {converged}"
+            );
+            assert!((s - s0).abs() < 1e-6, "{s0}: {s}");
+        }
+    }
 
     /// The written-out product is the rotations' own, on a canted, graded curve.
     #[test]
