@@ -129,7 +129,7 @@ pub struct ExperimentOptions {
     /// Window length, steps (the paper's 20 by default).
     pub window: usize,
     /// Window length of the mismatch experiment's models, steps (40 = 0.2 s by default: on
-    /// held-out wagons the paper's 21 + mass gave FL R² 0.913 at 20 steps and 0.927–0.936 at
+    /// held-out wagons the paper's 21 + mass gave FL R² 0.913 at 20 steps and 0.922–0.936 at
     /// 40, results.md "FL on held-out wagons"). Its nominal models are trained again when it
     /// differs from `window`.
     pub mismatch_window: usize,
