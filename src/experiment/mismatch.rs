@@ -325,6 +325,9 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     };
     let mut jobs = Vec::new();
     let mut reused: Vec<Option<PathBuf>> = Vec::new();
+    // Models trained in this invocation share the part's window only when the experiments'
+    // window is the mismatch's.
+    let same_window = opts.window == opts.mismatch_window;
     for (key, _, ins) in cases {
         let dir = if key == PAPER21 {
             &paper21_dir
@@ -332,9 +335,6 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             &selected_dir
         };
         let on_disk = || earlier(ctx, dir, nominal_ds, Some(ins)).map(|_| dir.clone());
-        // Models trained in this invocation share the part's window only when the
-        // experiments' window is the mismatch's.
-        let same_window = opts.window == opts.mismatch_window;
         match ctx.trained.iter().find(|(k, _)| same_window && *k == key) {
             Some((_, d)) => reused.push(Some(d.clone())),
             None if on_disk().is_some() => {
@@ -485,7 +485,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     .collect::<Vec<_>>()
                     .join("; ")
             ),
-            format!("Every model here reads windows of {} steps (the other parts' {}): on wagons they did not learn, 0.2 s read FL better than the paper's 0.1 s (assets/docs/results.md, \"FL on held-out wagons\").", opts.mismatch_window, opts.window),
+            format!("Every model here reads windows of {} steps (the other parts' {}; by default 40: on wagons they did not learn, 0.2 s read FL better than the paper's 0.1 s, assets/docs/results.md, \"FL on held-out wagons\").", opts.mismatch_window, opts.window),
             "Trained on the nominal wagon: the generalisation (paper's 21) and sensors (on-board selection) experiments' CNN-BiLSTMs where they ran in the same invocation with the same window, or earlier into the same folder on the same data and protocol. Trained on the fleet (domain randomisation): the same network, inputs and noise; validated and tested on the nominal split's seeds, trained on every other seed of the fleet plan (more wagons where the fleet plan draws more seeds); and once more with the vehicle's weighed mass (`vehicle_mass_t`, a constant of each run that the weighbridge ticket gives) beside each input set: the paper's 21 carry no load channel, so without it the payload's share of the wheel load is invisible to them. Every model is calibrated by split conformal on its own validation runs: \"covered\" is the share of true forces inside its 90 % interval, \"flagged\" the share of windows with an input beyond its training envelope (the rule `identify` warns by), and the RMSE where flagged against where quiet says whether the flag fires where the error is large.".into(),
             ctx.protocol_windowed(&ctx.split, Some(opts.snr_db), opts.mismatch_window),
             format!(
