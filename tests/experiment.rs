@@ -50,6 +50,7 @@ fn every_experiment_runs_end_to_end() {
         loco: vec!["curve_r400_v60".into()],
         window: 12,
         mismatch_window: 16,
+        mismatch_members: 2,
         train: TrainOptions {
             epochs: 2,
             patience: 2,
@@ -199,6 +200,40 @@ fn every_experiment_runs_end_to_end() {
         .unwrap();
         assert_eq!(model["data"]["window"], 16, "{m}");
     }
+    // The fleet models with the weighed mass are ensembles of two networks with heads (seeds
+    // 1 and 2, the second in member2/), the ones without it single networks.
+    for (m, members) in [
+        ("fleet_paper21_weighed", 2),
+        ("fleet_selected_weighed", 2),
+        ("fleet_paper21", 1),
+    ] {
+        let dir = out.join(format!("mismatch/models/{m}"));
+        let model: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("model.json")).unwrap())
+                .unwrap();
+        assert_eq!(model["members"].as_u64().unwrap_or(1), members, "{m}");
+        assert_eq!(
+            dir.join("weights_member2.bin").exists(),
+            members == 2,
+            "{m}"
+        );
+        if members == 2 {
+            let second: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(dir.join("member2/model.json")).unwrap(),
+            )
+            .unwrap();
+            assert_eq!(second["net"]["seed"], 2, "{m}");
+            assert_eq!(
+                second["net"]["quantiles"], 0.9,
+                "{m}: each member keeps its heads"
+            );
+            assert_eq!(
+                model["training"]["ensemble"].as_array().map(|a| a.len()),
+                Some(2)
+            );
+        }
+    }
+    assert!(html.contains("fleet, ensemble of 2"));
     let data = meta["data_fnv1a"].clone();
 
     // One part run again on its own into the same folder: the report still shows all six,

@@ -457,7 +457,7 @@ fn the_burn_engine_without_burn_says_how_to_build_it() {
 /// `y = 1000·a + σ·ε` with σ four times larger where the slow input `b` is positive, the
 /// heads' interval is wider there by about that factor (measured 3.1×), and the raw 90 %
 /// quantile interval covers close to 90 % of held-out windows (measured 91.3 %) before any
-/// conformal correction.
+/// conformal correction. Two of them joined into an ensemble spread by their total variance.
 #[test]
 fn quantile_heads_learn_where_the_noise_is_larger() {
     use rand::SeedableRng;
@@ -541,8 +541,44 @@ fn quantile_heads_learn_where_the_noise_is_larger() {
     );
     let coverage = covered as f64 / prep.test.len() as f64;
     assert!((0.8..0.97).contains(&coverage), "raw coverage {coverage}");
-    // Heads are one network's: an ensemble's members, classical models and the burn engine
-    // train without them.
+    // Two such networks joined (seeds 1 and 2, each with its heads): the ensemble's mean is
+    // the members' mean and its spread their total variance, Var_k(ŷ_k) + E_k(σ_k²), and the
+    // joined model reads back from disk predicting the same.
+    let second_out = tmp("quantile_heads_member2");
+    let mut second = train(
+        &ds,
+        &spec,
+        ModelKind::Cnn,
+        &TrainOptions {
+            seed: 2,
+            ..opts.clone()
+        },
+        &second_out,
+        &mut |_| {},
+    )
+    .unwrap();
+    let (mean2, spread2) = second.predict_spread(&x, prep.test.len());
+    let spread2 = spread2.expect("the second member's heads");
+    let mut joined = railforce::learn::uncertainty::join(vec![model, second], &ds, &out).unwrap();
+    assert_eq!(joined.meta.members, 2);
+    let (m, s) = joined.predict_spread(&x, prep.test.len());
+    let s = s.expect("an ensemble's spread");
+    for i in 0..m.len() {
+        let mu = 0.5 * (mean[i] + mean2[i]);
+        let var = 0.5 * ((mean[i] - mu).powi(2) + (mean2[i] - mu).powi(2))
+            + 0.5 * (spread[i].powi(2) + spread2[i].powi(2));
+        assert!((m[i] - mu).abs() < 1e-5, "mean {} against {mu}", m[i]);
+        assert!(
+            (s[i] - var.sqrt()).abs() < 1e-4 * (1.0 + s[i]),
+            "spread {} against {}",
+            s[i],
+            var.sqrt()
+        );
+    }
+    let mut back = railforce::learn::model::Model::load(&out).unwrap();
+    assert_eq!(back.predict_spread(&x, prep.test.len()), (m, Some(s)));
+    // `train --ensemble` keeps heads for one network only: its members' spread is their
+    // disagreement; classical models and the burn engine train without heads.
     assert_eq!(opts.heads_for(ModelKind::Cnn, 1), Some(0.9));
     assert_eq!(opts.heads_for(ModelKind::Cnn, 2), None);
     assert_eq!(opts.heads_for(ModelKind::Gbdt, 1), None);

@@ -100,6 +100,11 @@ pub struct ExperimentArgs {
     /// trained again rather than reused from the other parts).
     #[arg(long)]
     mismatch_window: Option<usize>,
+    /// Networks in each of the mismatch experiment's fleet-trained models with the weighed
+    /// mass, from seeds seed, seed + 1, …, joined into one ensemble (its mean averages out the
+    /// training seed; each member costs one more training). 1 to 32.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=32))]
+    mismatch_members: u16,
     /// Train the networks on the one fixed noisy copy of the inputs instead of drawing new
     /// noise every epoch (the default draws fresh noise at the same SNR; validation and test
     /// keep their fixed noise either way).
@@ -147,6 +152,7 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
     if let Some(w) = args.mismatch_window {
         opts.mismatch_window = w;
     }
+    opts.mismatch_members = args.mismatch_members.into();
     if args.last_label {
         opts.label_at = railforce::features::LabelAt::Last;
     }

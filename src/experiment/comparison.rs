@@ -55,6 +55,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     .join("models")
                     .join(format!("{}_{}", kind.name(), ["fl", "fq"][k])),
                 windows: Some(opts.condition_windows_per_epoch),
+                members: 1,
             });
         }
     }

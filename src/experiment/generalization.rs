@@ -44,6 +44,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         kind: ModelKind::CnnBiLstm,
         dir: dir.join("models/all_conditions"),
         windows: None,
+        members: 1,
     }];
     let mut vals = Vec::new();
     for c in &loco {
@@ -66,6 +67,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             kind: ModelKind::CnnBiLstm,
             dir: dir.join(format!("models/without_{c}")),
             windows: None,
+            members: 1,
         });
         vals.push(val);
     }

@@ -133,6 +133,11 @@ pub struct ExperimentOptions {
     /// 40, results.md "FL on held-out wagons"). Its nominal models are trained again when it
     /// differs from `window`.
     pub mismatch_window: usize,
+    /// Members of the mismatch experiment's fleet-trained models with the weighed mass (the
+    /// deployable ones): networks from seeds seed, seed + 1, … each with its quantile heads,
+    /// joined into one ensemble (2 by default: one network's FL R² on held-out wagons moved by
+    /// 0.026 with its training seed, results.md "An ensemble of two for the fleet").
+    pub mismatch_members: usize,
     /// Networks trained at an SNR (matched protocol) draw new training-input noise every
     /// epoch instead of learning one fixed realisation (validation and test keep theirs).
     pub fresh_noise: bool,
@@ -178,6 +183,7 @@ impl ExperimentOptions {
             label_at: LabelAt::Centre,
             window: 20,
             mismatch_window: 40,
+            mismatch_members: 2,
             fresh_noise: true,
             split: None,
             fleet: None,
@@ -285,6 +291,7 @@ impl Ctx<'_> {
         kind: ModelKind,
         dir: &Path,
         windows_per_epoch: Option<usize>,
+        member: usize,
     ) -> Result<(Model, f64)> {
         let t0 = Instant::now();
         let name = dir
@@ -298,6 +305,8 @@ impl Ctx<'_> {
                 .noise_model
                 .filter(|_| self.opts.fresh_noise && spec.noise == NoiseProtocol::Matched),
             windows_per_epoch: windows_per_epoch.or(self.opts.train.windows_per_epoch),
+            // An ensemble's members from seeds seed, seed + 1, … (as `train --ensemble`).
+            seed: self.opts.train.seed + member as u64,
             ..self.opts.train.clone()
         };
         let mut model = train(ds, spec, kind, &opts, dir, &mut |p| {
@@ -330,39 +339,62 @@ impl Ctx<'_> {
     }
 
     /// Trains every job, [`ExperimentOptions::jobs`] at a time (each training runs on one
-    /// thread and is seeded on its own, so the models do not depend on the order), and
-    /// returns the models in the order of the jobs.
+    /// thread and is seeded on its own, so the models do not depend on the order; an
+    /// ensemble's members train as jobs of their own, member k in `dir/member<k>`, and are
+    /// joined and calibrated at the end), and returns the models in the order of the jobs
+    /// with their wall time, s (an ensemble's: its members' sum).
     fn fit_all(&self, jobs: &[FitJob]) -> Result<Vec<(Model, f64)>> {
+        let tasks: Vec<(usize, usize)> = jobs
+            .iter()
+            .enumerate()
+            .flat_map(|(j, job)| (0..job.members.max(1)).map(move |k| (j, k)))
+            .collect();
         let next = std::sync::atomic::AtomicUsize::new(0);
         let done: std::sync::Mutex<Vec<Option<Fitted>>> =
-            std::sync::Mutex::new((0..jobs.len()).map(|_| None).collect());
+            std::sync::Mutex::new((0..tasks.len()).map(|_| None).collect());
         std::thread::scope(|scope| {
-            for _ in 0..self.opts.jobs.max(1).min(jobs.len()) {
+            for _ in 0..self.opts.jobs.max(1).min(tasks.len()) {
                 scope.spawn(|| {
                     loop {
-                        let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-                        let Some(j) = jobs.get(k) else { return };
-                        let r = self.fit(j.ds, &j.spec, j.kind, &j.dir, j.windows);
+                        let t = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                        let Some(&(j, k)) = tasks.get(t) else { return };
+                        let job = &jobs[j];
+                        let dir = if k == 0 {
+                            job.dir.clone()
+                        } else {
+                            job.dir.join(format!("member{}", k + 1))
+                        };
+                        let r = self.fit(job.ds, &job.spec, job.kind, &dir, job.windows, k);
                         let failed = r.is_err();
-                        done.lock().expect("results lock")[k] = Some(r);
+                        done.lock().expect("results lock")[t] = Some(r);
                         if failed {
                             // Stop handing out work: the first error ends the experiment.
-                            next.store(jobs.len(), std::sync::atomic::Ordering::SeqCst);
+                            next.store(tasks.len(), std::sync::atomic::Ordering::SeqCst);
                             return;
                         }
                     }
                 });
             }
         });
+        let mut fitted = done.into_inner().expect("results lock").into_iter();
         let mut out = Vec::with_capacity(jobs.len());
-        for r in done.into_inner().expect("results lock") {
-            match r {
-                Some(r) => out.push(r?),
-                None => {
-                    return Err(Error::Domain(
-                        "a training was not run after another failed".into(),
-                    ));
-                }
+        for job in jobs {
+            let mut members = Vec::new();
+            let mut secs = 0.0;
+            for _ in 0..job.members.max(1) {
+                let (m, s) = fitted.next().flatten().ok_or_else(|| {
+                    Error::Domain("a training was not run after another failed".into())
+                })??;
+                members.push(m);
+                secs += s;
+            }
+            if members.len() == 1 {
+                out.push((members.pop().expect("one member"), secs));
+            } else {
+                out.push((
+                    crate::learn::uncertainty::join(members, job.ds, &job.dir)?,
+                    secs,
+                ));
             }
         }
         Ok(out)
@@ -396,6 +428,8 @@ struct FitJob<'d> {
     kind: ModelKind,
     dir: PathBuf,
     windows: Option<usize>,
+    /// Networks from seeds seed, seed + 1, … joined into one ensemble (1: one network).
+    members: usize,
 }
 
 /// Simulates `plan` (clean, NPZ, 3 s settling) into `dir`, resuming what is there.
@@ -541,6 +575,7 @@ pub fn run(
         "label_at": format!("{:?}", opts.label_at),
         "window": opts.window,
         "mismatch_window": opts.mismatch_window,
+        "mismatch_members": opts.mismatch_members,
         "fresh_noise_every_epoch": opts.fresh_noise,
         "railforce_version": env!("CARGO_PKG_VERSION"),
     });

@@ -72,6 +72,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 kind: ModelKind::CnnBiLstm,
                 dir: dir.join(format!("models/{}", split.name())),
                 windows: None,
+                members: 1,
             })
         })
         .collect::<Result<Vec<_>>>()?;

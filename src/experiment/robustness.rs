@@ -51,6 +51,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             kind,
             dir: dir.join(format!("models/clean_{}", kind.name())),
             windows,
+            members: 1,
         });
     }
     for &kind in &opts.robustness_models {
@@ -67,6 +68,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 kind,
                 dir: dir.join(format!("models/matched_{}_{snr}dB", kind.name())),
                 windows,
+                members: 1,
             });
         }
     }

@@ -78,6 +78,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     }
                 )),
                 windows: None,
+                members: 1,
             })
         })
         .collect::<Result<Vec<_>>>()?;

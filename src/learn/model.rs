@@ -164,32 +164,40 @@ impl Model {
         self.predict_spread(x, n).0
     }
 
-    /// The prediction and, for an ensemble, its members' spread (population standard
-    /// deviation), both standardised `[n, outputs]`.
+    /// The prediction and its spread, both standardised `[n, outputs]`: one network with
+    /// quantile heads gives the heads' σ; an ensemble gives its members' mean, and as spread
+    /// the law of total variance over them, `σ² = Var_k(ŷ_k) + E_k(σ_k²)` (the members'
+    /// disagreement plus their own heads' σ where they have heads; Lakshminarayanan et al.
+    /// 2017, eq. 5); one plain network gives none.
     pub fn predict_spread(&mut self, x: &[f32], n: usize) -> (Vec<f32>, Option<Vec<f32>>) {
         let run = |e: &mut Engine| match e {
-            Engine::Net(net) => net.predict(x, n),
-            Engine::Classical(c) => c.predict(x, n),
+            Engine::Net(net) => match net.config.quantiles {
+                Some(c) => quantile_spread(&net.predict_all(x, n), net.config.outputs / 3, c),
+                None => (net.predict(x, n), None),
+            },
+            Engine::Classical(c) => (c.predict(x, n), None),
         };
-        if let Engine::Net(net) = &mut self.engine
-            && let Some(c) = net.config.quantiles
-        {
-            return quantile_spread(&net.predict_all(x, n), net.config.outputs / 3, c);
-        }
         let first = run(&mut self.engine);
         if self.members.is_empty() {
-            return (first, None);
+            return first;
         }
         let mut all = vec![first];
         for m in &mut self.members {
             all.push(run(m));
         }
         let k = all.len() as f32;
-        let mean: Vec<f32> = (0..all[0].len())
-            .map(|i| all.iter().map(|p| p[i]).sum::<f32>() / k)
+        let mean: Vec<f32> = (0..all[0].0.len())
+            .map(|i| all.iter().map(|p| p.0[i]).sum::<f32>() / k)
             .collect();
         let spread = (0..mean.len())
-            .map(|i| (all.iter().map(|p| (p[i] - mean[i]).powi(2)).sum::<f32>() / k).sqrt())
+            .map(|i| {
+                let own: f32 = all
+                    .iter()
+                    .filter_map(|p| p.1.as_ref().map(|s| s[i] * s[i]))
+                    .sum();
+                let between: f32 = all.iter().map(|p| (p.0[i] - mean[i]).powi(2)).sum();
+                ((between + own) / k).sqrt()
+            })
             .collect();
         (mean, Some(spread))
     }

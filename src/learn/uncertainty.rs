@@ -146,8 +146,7 @@ pub fn train_ensemble(
         quantile_heads: opts.heads_for(kind, members),
         ..opts.clone()
     };
-    let mut model: Option<Model> = None;
-    let mut summaries = Vec::new();
+    let mut trained = Vec::with_capacity(members);
     for k in 0..members {
         let o = TrainOptions {
             seed: opts.seed + k as u64,
@@ -158,14 +157,50 @@ pub fn train_ensemble(
         } else {
             out.join(format!("member{}", k + 1))
         };
-        let m = train(ds, spec, kind, &o, &dir, &mut |p| progress(k, p))?;
-        summaries.push(m.meta.training.clone());
-        match &mut model {
-            None => model = Some(m),
-            Some(first) => first.members.push(m.engine),
-        }
+        trained.push(train(ds, spec, kind, &o, &dir, &mut |p| progress(k, p))?);
     }
-    let mut model = model.expect("at least one member");
+    join(trained, ds, out)
+}
+
+/// Joins separately trained `members` (the same kind, data spec and statistics; member 1's
+/// weights in `out`, the others' beside them) into one model whose prediction is their mean
+/// and whose spread is their total variance ([`Model::predict_spread`]), calibrates it on the
+/// validation part of `ds` and saves it in `out`. One member is returned calibrated as it is.
+pub fn join(members: Vec<Model>, ds: &DataSet, out: &Path) -> Result<Model> {
+    let mut it = members.into_iter();
+    let mut model = it
+        .next()
+        .ok_or_else(|| Error::Domain("an ensemble needs at least one member".into()))?;
+    let mut summaries = vec![model.meta.training.clone()];
+    for m in it {
+        let same = m.meta.kind == model.meta.kind
+            && m.meta.data == model.meta.data
+            && m.meta.input_stats == model.meta.input_stats
+            && m.meta.target_stats == model.meta.target_stats
+            && m.meta
+                .net
+                .as_ref()
+                .map(|n| (n.window, n.channels, n.outputs, n.quantiles))
+                == model
+                    .meta
+                    .net
+                    .as_ref()
+                    .map(|n| (n.window, n.channels, n.outputs, n.quantiles));
+        if !same {
+            return Err(Error::Domain(
+                "ensemble members differ in kind, data, statistics or shape: they cannot be joined"
+                    .into(),
+            ));
+        }
+        summaries.push(m.meta.training.clone());
+        model.members.push(m.engine);
+    }
+    let members = summaries.len();
+    if members > 32 {
+        return Err(Error::Domain(format!(
+            "an ensemble has 1 to 32 members, got {members}"
+        )));
+    }
     model.meta.members = members;
     if members > 1
         && let Some(obj) = model.meta.training.as_object_mut()
