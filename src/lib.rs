@@ -9,6 +9,7 @@
 
 #![warn(missing_docs)]
 
+pub mod angle;
 pub mod assess;
 pub mod builtin;
 pub mod contact;

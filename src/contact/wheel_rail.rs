@@ -159,14 +159,14 @@ impl ContactFrame {
     /// Frame of a contact with angle `angle` on `side` (positive angles tilt the normal toward
     /// the track centre… of the wheel: the flange is pushed toward the field side).
     pub fn new(side: Side, angle: f64, yaw: f64) -> Self {
-        let (sy, cy) = yaw.sin_cos();
+        let (sy, cy) = crate::angle::sin_cos(yaw);
         Self::with_yaw(side, angle, sy, cy)
     }
 
     /// [`Self::new`] from the yaw's sine and cosine (both patches of a wheel share them).
     fn with_yaw(side: Side, angle: f64, sy: f64, cy: f64) -> Self {
         let s = side.sign();
-        let (sd, cd) = angle.sin_cos();
+        let (sd, cd) = crate::angle::sin_cos(angle);
         ContactFrame {
             tx: [cy, sy, 0.0],
             ty: [-sy * cd, cy * cd, s * sd],
@@ -216,8 +216,8 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
         .strips()
         .patches(i, t, k, approach, droll, &model.material);
     let speed = w.speed.abs().max(CREEP_SPEED_FLOOR);
-    let (sy, cy) = w.yaw.sin_cos();
-    let (sr, cr) = droll.sin_cos();
+    let (sy, cy) = crate::angle::sin_cos(w.yaw);
+    let (sr, cr) = crate::angle::sin_cos(droll);
     let mut patches: [Option<PatchForce>; 2] = [None, None];
     let (mut force, mut moment) = ([0.0; 3], [0.0; 3]);
     for (slot, load) in patches.iter_mut().zip(loads) {

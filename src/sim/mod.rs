@@ -504,7 +504,8 @@ impl<'a> Simulation<'a> {
         let force = m
             * (h.proportional * err
                 + h.integral * self.hauling_integral
-                + crate::GRAVITY * f.point.gradient.atan().sin());
+                // sin(atan g) = g / √(1 + g²)
+                + crate::GRAVITY * f.point.gradient / (1.0 + f.point.gradient.powi(2)).sqrt());
         self.wrenches[h.body].force += along * force;
     }
 

@@ -161,8 +161,8 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
             w.z,
             rel.y,
             rel.z,
-            y_axis.z.asin(),
-            (-y_axis.x).atan2(y_axis.y),
+            crate::angle::asin(y_axis.z),
+            crate::angle::atan2(-y_axis.x, y_axis.y),
         ]);
     }
     let mut k = 0;

@@ -25,7 +25,7 @@ impl TrackFrame {
         let (sh, ch) = p.heading.sin_cos();
         let cg = 1.0 / (1.0 + p.gradient * p.gradient).sqrt();
         let sg = p.gradient * cg;
-        let (sc, cc) = p.cant_angle.sin_cos();
+        let (sc, cc) = crate::angle::sin_cos(p.cant_angle);
         // Ry(−θ)·Rx(φ) = [cθ, −sθ·sφ, −sθ·cφ; 0, cφ, −sφ; sθ, cθ·sφ, cθ·cφ].
         let m = Matrix3::new(cg, -sg * sc, -sg * cc, 0.0, cc, -sc, sg, cg * sc, cg * cc);
         let rz = Matrix3::new(ch, -sh, 0.0, sh, ch, 0.0, 0.0, 0.0, 1.0);

@@ -113,7 +113,10 @@ impl Simulation<'_> {
         let f = self.frames[b];
         let rel = f.to_local(&(st.position - f.origin));
         let axle = (f.axes.transpose() * st.matrix()).column(1).into_owned();
-        let (roll, yaw) = (axle.z.asin(), (-axle.x).atan2(axle.y));
+        let (roll, yaw) = (
+            crate::angle::asin(axle.z),
+            crate::angle::atan2(-axle.x, axle.y),
+        );
         let v = f.axes.transpose() * st.velocity;
         let omega = f.axes.transpose() * st.angular_velocity;
         let r = f.rails();

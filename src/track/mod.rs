@@ -113,7 +113,7 @@ impl Track {
             heading: self.alignment.heading(s),
             curvature: self.alignment.curvature(s),
             cant,
-            cant_angle: (cant / self.spec.rail_spacing).asin(),
+            cant_angle: crate::angle::asin(cant / self.spec.rail_spacing),
             elevation,
             gradient,
             vertical_curvature,

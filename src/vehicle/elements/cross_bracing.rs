@@ -43,7 +43,7 @@ impl CrossBracing {
         let d = l.position - r.position;
         let dx = c * d.x + s * d.y;
         let dy = -s * d.x + c * d.y;
-        (dx.atan2(dy), dy, Vector3::new(c, s, 0.0))
+        (crate::angle::atan2(dx, dy), dy, Vector3::new(c, s, 0.0))
     }
 
     fn forces(&self, states: &[BodyState], wrenches: &mut [Wrench]) {

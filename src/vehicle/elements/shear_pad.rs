@@ -95,7 +95,7 @@ impl ShearPad {
             // independent of the wheelset's spin about that axis.
             let axle = sl.matrix().column(1).into_owned();
             let a = r.axes.transpose() * axle;
-            let theta = (-a.z).atan2(a.y);
+            let theta = crate::angle::atan2(-a.z, a.y);
             let w_lower = sl.angular_velocity - axle * sl.angular_velocity.dot(&axle);
             let x_upper = r.axes.column(0).into_owned();
             let theta_dot = (su.angular_velocity - w_lower).dot(&x_upper);

@@ -33,7 +33,7 @@ impl TrackSpring {
         let st = &states[self.body];
         let rel = axes.transpose() * (st.position - origin);
         let axle = axes.transpose() * st.matrix().column(1);
-        let yaw = (-axle.x).atan2(axle.y);
+        let yaw = crate::angle::atan2(-axle.x, axle.y);
         let lateral = axes.column(1).into_owned();
         let up = axes.column(2).into_owned();
         wrenches[self.body].force -= lateral * (self.lateral_stiffness * rel.y);
