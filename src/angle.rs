@@ -52,7 +52,8 @@ pub fn asin(x: f64) -> f64 {
 /// `atan2(y, x)` for `x > 0`, exact to rounding.
 #[inline]
 pub fn atan2(y: f64, x: f64) -> f64 {
-    if !(x > 0.0) || y.abs() > SMALL * x {
+    let small = x > 0.0 && y.abs() <= SMALL * x;
+    if !small {
         return y.atan2(x);
     }
     let r = y / x;
