@@ -161,8 +161,28 @@ impl FilterBank {
     }
 
     /// Filters one sample of every channel in place (`x` holds [`Self::channels`] values).
+    /// Where the CPU has AVX the same code runs four lanes wide instead of two: the same
+    /// multiplications and additions in the same order (no fused multiply-add), so the same
+    /// numbers to the last bit on any machine.
     #[inline]
     pub fn step(&mut self, x: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX (checked just above).
+            unsafe { self.step_avx(x) };
+            return;
+        }
+        self.step_lanes(x);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn step_avx(&mut self, x: &mut [f64]) {
+        self.step_lanes(x);
+    }
+
+    #[inline(always)]
+    fn step_lanes(&mut self, x: &mut [f64]) {
         let n = self.channels;
         let x = &mut x[..n];
         for (j, sec) in self.sections.iter().enumerate() {
@@ -198,6 +218,31 @@ mod tests {
             x.iter().map(|&v| lp.step(v, &mut st)).collect()
         };
         y[15_000..25_000].iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    #[test]
+    fn a_bank_gives_each_channels_single_filter_to_the_last_bit() {
+        // 13 channels: full vector lanes and a remainder, on whichever path the CPU takes.
+        let lp = Butterworth::lowpass(8, 50.0, 2000.0);
+        let n = 13;
+        let mut bank = lp.bank(n);
+        let mut states = vec![vec![0.0; lp.order()]; n];
+        let start: Vec<f64> = (0..n).map(|c| c as f64 * 0.3 - 1.0).collect();
+        bank.hold(&start);
+        for (st, &x) in states.iter_mut().zip(&start) {
+            lp.steady_state(x, st);
+        }
+        for i in 0..500 {
+            let x: Vec<f64> = (0..n)
+                .map(|c| ((i * 7 + c * 13) % 29) as f64 - 14.0)
+                .collect();
+            let mut y = x.clone();
+            bank.step(&mut y);
+            for c in 0..n {
+                let single = lp.step(x[c], &mut states[c]);
+                assert_eq!(y[c].to_bits(), single.to_bits(), "channel {c}, sample {i}");
+            }
+        }
     }
 
     #[test]

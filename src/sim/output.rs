@@ -234,8 +234,13 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
         }
     }
     for e in &v.elements {
+        // Elements without gauges (wedges, stops, bracing) are not measured at all.
+        let axes = e.gauge_axes();
+        if axes.is_empty() {
+            continue;
+        }
         if let Some(d) = e.deflection(states) {
-            for &axis in e.gauge_axes() {
+            for &axis in axes {
                 put(d[axis]);
             }
         }
