@@ -155,6 +155,14 @@ fn contact_prints_both_wheels_and_flags_flange_contact() {
 }
 
 #[test]
+fn bench_simulate_needs_at_least_one_measurement() {
+    let (ok, _, err) = railforce(&["bench", "simulate", "--repeat", "0"]);
+    assert!(!ok && err.contains("--repeat"), "{err}");
+    let (ok, out, _) = railforce(&["bench", "simulate", "--help"]);
+    assert!(ok && out.contains("fastest counts"), "{out}");
+}
+
+#[test]
 fn validate_contact_passes_on_the_built_in_reference_data_from_any_folder() {
     // Run from an empty folder: the reference data are built into the binary.
     let dir = std::env::temp_dir().join(format!("railforce-vc-{}", std::process::id()));

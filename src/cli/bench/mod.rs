@@ -65,6 +65,10 @@ enum What {
         /// Simulated seconds per measurement.
         #[arg(long, default_value_t = 20.0)]
         seconds: f64,
+        /// Measurements of each kind, taken in turn; the fastest counts and the slowest is
+        /// shown beside it (on a shared machine other work only ever slows a run down).
+        #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..))]
+        repeat: u64,
         /// Integrator (default: the default; `bench step` measures what each costs in accuracy).
         #[arg(long, value_parser = railforce::sim::Integrator::NAMES)]
         integrator: Option<String>,
@@ -164,6 +168,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             track,
             speed_kmh,
             seconds,
+            repeat,
             integrator,
             dt,
         } => {
@@ -182,16 +187,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 dt: stepping.dt,
                 ..default.clone()
             };
-            let b = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, &base)?;
+            let repeat = repeat as usize;
+            let b = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, repeat, &base)?;
             println!(
-                "simulation benchmark: {} on {}, {speed_kmh} km/h, {seconds} s, {} step {} ms, one thread",
+                "simulation benchmark: {} on {}, {speed_kmh} km/h, {seconds} s, {} step {} ms, one thread, fastest of {repeat}",
                 v.name,
                 tr.spec().name,
                 base.integrator.name(),
                 b.dt * 1e3
             );
             if base.integrator != default.integrator || base.dt != default.dt {
-                let r = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, &default)?;
+                let r = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, repeat, &default)?;
                 println!(
                     "  against the default ({} at {} ms) in the same run: physics {:.2}× ({:.1}× real time), all channels {:.2}× ({:.1}× real time)",
                     default.integrator.name(),
@@ -202,13 +208,23 @@ pub fn run(args: BenchArgs) -> Result<()> {
                     r.real_time_factor_recorded
                 );
             }
+            let slowest = |us: f64| {
+                if repeat > 1 {
+                    format!(" (slowest {us:.2})")
+                } else {
+                    String::new()
+                }
+            };
             println!(
-                "  physics only:       {:>6.2} µs per step, {:>5.1}× real time",
-                b.step_us, b.real_time_factor
+                "  physics only:       {:>6.2} µs per step{}, {:>5.1}× real time",
+                b.step_us,
+                slowest(b.slowest_us.0),
+                b.real_time_factor
             );
             println!(
-                "  with all channels:  {:>6.2} µs per step, {:>5.1}× real time (recording costs {:.0} % of the physics)",
+                "  with all channels:  {:>6.2} µs per step{}, {:>5.1}× real time (recording costs {:.0} % of the physics)",
                 b.step_recorded_us,
+                slowest(b.slowest_us.1),
                 b.real_time_factor_recorded,
                 100.0 * (b.step_recorded_us / b.step_us - 1.0)
             );

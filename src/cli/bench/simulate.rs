@@ -11,10 +11,13 @@ use std::time::Instant;
 pub struct SimulateBench {
     /// Integration step, s.
     pub dt: f64,
-    /// Wall time per integration step, physics only, µs.
+    /// Wall time per integration step, physics only, µs (the fastest of the repeats).
     pub step_us: f64,
-    /// Wall time per step with all channels filtered and sampled, µs.
+    /// Wall time per step with all channels filtered and sampled, µs (the fastest).
     pub step_recorded_us: f64,
+    /// The slowest repeat's physics-only and recorded µs per step (the spread a shared
+    /// machine adds; equal to the fastest with one repeat).
+    pub slowest_us: (f64, f64),
     /// Simulated over wall time, physics only.
     pub real_time_factor: f64,
     /// Simulated over wall time, with recording.
@@ -28,13 +31,15 @@ pub struct SimulateBench {
     pub elements: Vec<(&'static str, usize, f64)>,
 }
 
-/// Runs `seconds` of simulated time twice (physics only, then with the recorder) at `speed` on
-/// `track`, with the step and integrator of `base`.
+/// Runs `seconds` of simulated time physics only, then with the recorder, `repeats` times in
+/// turn at `speed` on `track`, with the step and integrator of `base`; the fastest of each
+/// counts (a run only ever gets slower from what else the machine does).
 pub fn run(
     vehicle: &Vehicle,
     track: &Track,
     speed: f64,
     seconds: f64,
+    repeats: usize,
     base: &SimConfig,
 ) -> Result<SimulateBench> {
     let cfg = SimConfig {
@@ -51,24 +56,31 @@ pub fn run(
         ..base.clone()
     };
     let steps = (seconds / dt).round() as usize;
-    let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
-    let t = Instant::now();
-    for _ in 0..steps {
-        sim.step()?;
-    }
-    let plain = t.elapsed().as_secs_f64();
-    let mut sim = Simulation::new(vehicle, track, cfg)?;
-    let mut rec = Recorder::new(&sim);
-    let mut acc = 0.0;
-    let t = Instant::now();
-    for _ in 0..steps {
-        sim.step()?;
-        if let Some(row) = rec.sample(&mut sim) {
-            acc += row[2];
+    let (mut plain, mut recorded) = (Vec::new(), Vec::new());
+    for _ in 0..repeats.max(1) {
+        let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
+        let t = Instant::now();
+        for _ in 0..steps {
+            sim.step()?;
         }
+        plain.push(t.elapsed().as_secs_f64());
+        let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
+        let mut rec = Recorder::new(&sim);
+        let mut acc = 0.0;
+        let t = Instant::now();
+        for _ in 0..steps {
+            sim.step()?;
+            if let Some(row) = rec.sample(&mut sim) {
+                acc += row[2];
+            }
+        }
+        std::hint::black_box(acc);
+        recorded.push(t.elapsed().as_secs_f64());
     }
-    std::hint::black_box(acc);
-    let recorded = t.elapsed().as_secs_f64();
+    let fastest = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let slowest = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    let per_step = |s: f64| s * 1e6 / steps as f64;
+    let (plain_s, recorded_s) = (fastest(&plain), fastest(&recorded));
     // Profiled: the same run with the clock read around every part of the step, and around
     // the recorder.
     let clock = railforce::sim::profile::clock_cost_ns();
@@ -99,9 +111,10 @@ pub fn run(
         profile,
         profiled_step_us: profiled * 1e6 / steps as f64,
         dt,
-        step_us: plain * 1e6 / steps as f64,
-        step_recorded_us: recorded * 1e6 / steps as f64,
-        real_time_factor: seconds / plain,
-        real_time_factor_recorded: seconds / recorded,
+        step_us: per_step(plain_s),
+        step_recorded_us: per_step(recorded_s),
+        slowest_us: (per_step(slowest(&plain)), per_step(slowest(&recorded))),
+        real_time_factor: seconds / plain_s,
+        real_time_factor_recorded: seconds / recorded_s,
     })
 }
