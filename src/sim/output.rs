@@ -111,16 +111,14 @@ impl Recorder {
 
     /// Turns the timing of [`Recorder::sample`]'s parts on (cleared) or off.
     pub fn set_profiling(&mut self, on: bool) {
-        self.profile = on.then(|| {
-            (
-                [
-                    ("every body's track frame (every 10th step)", Duration::ZERO),
-                    ("the channels computed", Duration::ZERO),
-                    ("the low-pass filter bank", Duration::ZERO),
-                ],
-                0,
-            )
-        });
+        self.profile = on.then_some((
+            [
+                ("every body's track frame (every 10th step)", Duration::ZERO),
+                ("the channels computed", Duration::ZERO),
+                ("the low-pass filter bank", Duration::ZERO),
+            ],
+            0,
+        ));
     }
 
     /// With profiling on: each part of a sample, its mean µs per sample (the clock's cost per
