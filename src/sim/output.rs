@@ -10,6 +10,7 @@
 //! [`Accelerometers`]: crate::vehicle::Accelerometers
 
 use super::filter::Lowpass;
+use super::profile::StepProfile;
 use super::{Simulation, wheel_name};
 use crate::error::{Error, Result};
 use crate::sensors::{PAPER_CHANNELS, PAPER_UNITS};
@@ -17,7 +18,7 @@ use crate::vehicle::Accelerometers;
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 pub use crate::sensors::VEHICLE_MASS;
 
@@ -57,8 +58,8 @@ pub struct Recorder {
     paper: bool,
     /// Each body's ten values of the step (kept to spare an allocation a step).
     bodies: Vec<[f64; 10]>,
-    /// With profiling on: time spent in each part of [`Recorder::sample`] and samples taken.
-    profile: Option<([(&'static str, Duration); 3], u64)>,
+    /// With profiling on: time spent in each part of [`Recorder::sample`], per sample.
+    profile: Option<StepProfile>,
 }
 
 impl Recorder {
@@ -111,32 +112,16 @@ impl Recorder {
 
     /// Turns the timing of [`Recorder::sample`]'s parts on (cleared) or off.
     pub fn set_profiling(&mut self, on: bool) {
-        self.profile = on.then_some((
-            [
-                ("every body's track frame (every 10th step)", Duration::ZERO),
-                ("the channels computed", Duration::ZERO),
-                ("the low-pass filter bank", Duration::ZERO),
-            ],
-            0,
-        ));
+        self.profile = on.then(StepProfile::default);
     }
 
-    /// With profiling on: each part of a sample, its mean µs per sample (the clock's cost per
-    /// reading, `clock_ns`, taken off).
-    pub fn profile(&self, clock_ns: f64) -> Vec<(&'static str, f64)> {
-        let Some((parts, n)) = &self.profile else {
-            return Vec::new();
-        };
-        let n = (*n).max(1) as f64;
-        parts
-            .iter()
-            .map(|(name, d)| {
-                (
-                    *name,
-                    (d.as_secs_f64() * 1e9 - clock_ns * n).max(0.0) * 1e-3 / n,
-                )
-            })
-            .collect()
+    /// With profiling on: each part of a sample, mean µs and calls per sample
+    /// ([`StepProfile::per_step`]; `clock_ns`, the clock's cost per part, taken off).
+    pub fn profile(&self, clock_ns: f64) -> Vec<(String, f64, f64)> {
+        self.profile
+            .as_ref()
+            .map(|p| p.per_step(clock_ns))
+            .unwrap_or_default()
     }
 
     /// Channel names, in column order.
@@ -153,26 +138,29 @@ impl Recorder {
     /// The first call initialises the filters to the current values (no start transient).
     pub fn sample(&mut self, sim: &mut Simulation) -> Option<&[f64]> {
         let mut clock = self.profile.is_some().then(Instant::now);
-        // Adds the time since the last reading to part `k` (profiling only).
-        let mut lap = |profile: &mut Option<([(&str, Duration); 3], u64)>, k: usize| {
-            if let (Some(t), Some((parts, _))) = (clock.as_mut(), profile.as_mut()) {
+        // Adds the time since the last reading to `part` (profiling only).
+        let mut lap = |profile: &mut Option<StepProfile>, part: &str| {
+            if let (Some(t), Some(p)) = (clock.as_mut(), profile.as_mut()) {
                 let now = Instant::now();
-                parts[k].1 += now - *t;
+                p.add(part, now - *t);
                 *t = now;
             }
         };
         sim.refresh_frames();
-        lap(&mut self.profile, 0);
+        lap(
+            &mut self.profile,
+            "every body's track frame (every 10th step)",
+        );
         let sim = &*sim;
         signals(sim, self.paper, &mut self.bodies, &mut self.row);
         if self.count == 0 {
             self.filters.hold(&self.row[2..]);
         }
-        lap(&mut self.profile, 1);
+        lap(&mut self.profile, "the channels computed");
         self.filters.step(&mut self.row[2..]);
-        lap(&mut self.profile, 2);
-        if let Some((_, n)) = self.profile.as_mut() {
-            *n += 1;
+        lap(&mut self.profile, "the low-pass filter bank");
+        if let Some(p) = self.profile.as_mut() {
+            p.steps += 1;
         }
         let due = self.count.is_multiple_of(self.every);
         self.count += 1;

@@ -108,8 +108,8 @@ pub fn run(
         1.0,
     ));
     // The recorder's parts: one reading (half a pair) each.
-    for (part, us) in rec.profile(0.5 * clock) {
-        profile.push((format!("  of which {part}"), us, 1.0));
+    for (part, us, calls) in rec.profile(0.5 * clock) {
+        profile.push((format!("  of which {part}"), us, calls));
     }
     let elements = sim.element_costs(20_000);
     Ok(SimulateBench {
