@@ -434,3 +434,36 @@ impl StripTable {
         (out, least)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// The AVX build of the strip sums gives the portable build's patches to the last bit,
+    /// over the table's shifts (both wheels, between tabulated states), approaches from a
+    /// touch to a flange contact and rolls either way.
+    #[test]
+    fn the_vector_build_gives_the_portable_patches_to_the_last_bit() {
+        let v = crate::vehicle::Vehicle::load("vehicles/c80.toml".as_ref()).unwrap();
+        let table = v.contact.table();
+        let material = v.contact.model().material;
+        let strips = table.strips();
+        let mut loaded = 0;
+        for y in (-40..=40).map(|k| k as f64 * 2.7e-4) {
+            let (i, t) = table.locate(y);
+            for k in 0..2 {
+                for approach in [2e-5, 1e-4, 3.5e-4, 8e-4] {
+                    for roll in [-2e-3, 0.0, 1.5e-3] {
+                        let fast = strips.patches(i, t, k, approach, roll, &material);
+                        let portable = strips.patches_lanes(i, t, k, approach, roll, &material);
+                        assert_eq!(
+                            format!("{fast:?}"),
+                            format!("{portable:?}"),
+                            "y {y}, wheel {k}, approach {approach}, roll {roll}"
+                        );
+                        loaded += fast.0.iter().flatten().count();
+                    }
+                }
+            }
+        }
+        assert!(loaded > 500, "only {loaded} patches loaded");
+    }
+}
