@@ -404,30 +404,49 @@ impl StripTable {
                 ys[m] = y;
                 ds[m] = approach - roll * y - (ga + t * (gb - ga));
             }
-            for m in 0..len {
-                let (y, d) = (ys[m], ds[m]);
-                // `least.min(-d)` without its NaN handling on the critical path (the same
-                // value: a NaN `d` leaves `least` as it was either way).
-                if -d < least {
-                    least = -d;
-                }
-                if d <= 0.0 {
+            let (sa, sb) = (
+                &self.strips[ia0 + start..ia0 + start + len],
+                &self.strips[ib0 + start..ib0 + start + len],
+            );
+            let mut m = 0;
+            while m < len {
+                if ds[m] <= 0.0 {
+                    // `least.min(-d)` without its NaN handling on the critical path (the same
+                    // value: a NaN `d` leaves `least` as it was either way).
+                    if -ds[m] < least {
+                        least = -ds[m];
+                    }
                     close(&mut acc, &mut open, &mut out);
+                    m += 1;
                     continue;
                 }
-                open = true;
-                let (a, b) = (&self.strips[ia0 + start + m], &self.strips[ib0 + start + m]);
-                // Lane by lane `a + t·(b − a)`, as the scalar interpolation wrote it.
-                let q: [f64; 8] = std::array::from_fn(|l| a[l] + t * (b[l] - a[l]));
-                let n = q[0] * d;
-                acc.n += n;
-                acc.ny += n * y;
-                acc.k += q[0];
-                // All eight lanes (the first, N·stiffness, unused) so that they go as two
-                // vectors of four.
-                for l in 0..8 {
-                    acc.nq[l] += n * q[l];
+                // A run of penetrated strips (a NaN penetration too, which poisons the sums
+                // as it should), summed in registers.
+                let mut z = acc;
+                loop {
+                    let (y, d) = (ys[m], ds[m]);
+                    if -d < least {
+                        least = -d;
+                    }
+                    let (a, b) = (&sa[m], &sb[m]);
+                    // Lane by lane `a + t·(b − a)`, as the scalar interpolation wrote it.
+                    let q: [f64; 8] = std::array::from_fn(|l| a[l] + t * (b[l] - a[l]));
+                    let n = q[0] * d;
+                    z.n += n;
+                    z.ny += n * y;
+                    z.k += q[0];
+                    // All eight lanes (the first, N·stiffness, unused) so that they go as two
+                    // vectors of four.
+                    for l in 0..8 {
+                        z.nq[l] += n * q[l];
+                    }
+                    m += 1;
+                    if m == len || ds[m] <= 0.0 {
+                        break;
+                    }
                 }
+                acc = z;
+                open = true;
             }
         }
         close(&mut acc, &mut open, &mut out);
