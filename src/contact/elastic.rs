@@ -437,8 +437,8 @@ impl StripTable {
                     z.k += q[0];
                     // All eight lanes (the first, N·stiffness, unused) so that they go as two
                     // vectors of four.
-                    for l in 0..8 {
-                        z.nq[l] += n * q[l];
+                    for (s, q) in z.nq.iter_mut().zip(q) {
+                        *s += n * q;
                     }
                     m += 1;
                     if m == len || ds[m] <= 0.0 {
