@@ -231,6 +231,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             println!(
                 "  contact table (once per wheelset geometry in a process, all cores): {table_s:.2} s"
             );
+            println!("  build: {}", railforce::sim::profile::vector_build());
             println!(
                 "where a recorded step's time goes (a profiled run: {:.2} µs per step with the clock read around every part; the clock's own cost taken off):",
                 b.profiled_step_us
