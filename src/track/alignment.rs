@@ -228,6 +228,16 @@ impl Alignment {
         &self.pieces[i.min(self.pieces.len() - 1)]
     }
 
+    /// Position `(x, y)`, heading, curvature and cant at `s`, the piece found once (what
+    /// [`Alignment::position`], [`Alignment::heading`], [`Alignment::curvature`] and
+    /// [`Alignment::cant`] give one by one, the same numbers).
+    #[inline]
+    pub fn at(&self, s: f64) -> (f64, f64, f64, f64, f64) {
+        let (x, y) = self.position(s);
+        let p = self.piece(s);
+        (x, y, p.heading(s), p.curvature(s), p.cant(s))
+    }
+
     /// Signed curvature at `s`, 1/m (positive to the left).
     pub fn curvature(&self, s: f64) -> f64 {
         self.piece(s).curvature(s)

@@ -402,10 +402,23 @@ impl Irregularities {
 
     /// One channel and its derivative at `s` (Catmull–Rom cubic interpolation).
     pub fn channel_at(&self, ch: Channel, s: f64) -> (f64, f64) {
+        let (i, t) = self.locate(s);
+        self.cubic(ch, i, t)
+    }
+
+    /// The grid interval of `s` and the fraction into it (every channel has the same grid).
+    #[inline]
+    fn locate(&self, s: f64) -> (usize, f64) {
+        let n = self.samples[0].len();
+        let u = ((s - self.origin) / self.dx).clamp(1.0, (n - 3) as f64);
+        let i = (u.floor() as usize).min(n - 3);
+        (i, u - i as f64)
+    }
+
+    /// One channel's Catmull–Rom value and derivative in interval `i` at fraction `t`.
+    #[inline]
+    fn cubic(&self, ch: Channel, i: usize, t: f64) -> (f64, f64) {
         let v = &self.samples[ch as usize];
-        let u = ((s - self.origin) / self.dx).clamp(1.0, (v.len() - 3) as f64);
-        let i = (u.floor() as usize).min(v.len() - 3);
-        let t = u - i as f64;
         let (p0, p1, p2, p3) = (v[i - 1], v[i], v[i + 1], v[i + 2]);
         let a = 2.0 * p1;
         let b = p2 - p0;
@@ -453,10 +466,11 @@ impl Irregularities {
 
     /// Rail offsets without the fade-in.
     pub fn raw_rails_at(&self, s: f64) -> RailIrregularity {
-        let (zv, zv_d) = self.channel_at(Channel::Vertical, s);
-        let (ya, ya_d) = self.channel_at(Channel::Alignment, s);
-        let (zc, zc_d) = self.channel_at(Channel::CrossLevel, s);
-        let (yg, yg_d) = self.channel_at(Channel::Gauge, s);
+        let (i, t) = self.locate(s);
+        let (zv, zv_d) = self.cubic(Channel::Vertical, i, t);
+        let (ya, ya_d) = self.cubic(Channel::Alignment, i, t);
+        let (zc, zc_d) = self.cubic(Channel::CrossLevel, i, t);
+        let (yg, yg_d) = self.cubic(Channel::Gauge, i, t);
         RailIrregularity {
             left_y: ya + 0.5 * yg,
             left_z: zv + 0.5 * zc,

@@ -103,15 +103,14 @@ impl Track {
     /// Everything the track says at `s` (clamped to the track).
     pub fn at(&self, s: f64) -> TrackPoint {
         let s = s.clamp(0.0, self.length());
-        let (x, y) = self.alignment.position(s);
-        let cant = self.alignment.cant(s);
+        let (x, y, heading, curvature, cant) = self.alignment.at(s);
         let (elevation, gradient, vertical_curvature) = self.spec.profile.at(s);
         TrackPoint {
             s,
             x,
             y,
-            heading: self.alignment.heading(s),
-            curvature: self.alignment.curvature(s),
+            heading,
+            curvature,
             cant,
             cant_angle: crate::angle::asin(cant / self.spec.rail_spacing),
             elevation,
@@ -129,8 +128,8 @@ impl Track {
     /// [`Track::at`]: no profile, cant or irregularities).
     pub fn centre_line(&self, s: f64) -> (f64, f64, f64, f64) {
         let s = s.clamp(0.0, self.length());
-        let (x, y) = self.alignment.position(s);
-        (x, y, self.alignment.heading(s), self.alignment.curvature(s))
+        let (x, y, heading, curvature, _) = self.alignment.at(s);
+        (x, y, heading, curvature)
     }
 
     /// Like [`Track::at`] but fails outside the track, for callers that must not run off it.
