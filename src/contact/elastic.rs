@@ -88,6 +88,23 @@ pub struct StripTable {
     gap_y: Vec<[f64; 2]>,
 }
 
+/// Where a wheel stands on a [`StripTable`]: between tabulated states `i` and `i + 1`
+/// (fraction `t`), wheel `k` (0 left, 1 right), its centre `approach` below the table's rigid
+/// height and rolled `roll` beyond the table's roll (m, rad).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StripQuery {
+    /// Tabulated state below the wheel's shift.
+    pub i: usize,
+    /// Fraction of the way to state `i + 1`.
+    pub t: f64,
+    /// Wheel: 0 left, 1 right.
+    pub k: usize,
+    /// Vertical approach of the wheelset centre below the table's rigid height, m.
+    pub approach: f64,
+    /// Roll beyond the table's, rad.
+    pub roll: f64,
+}
+
 /// Running sums over the strips of the zone being walked: `N`, `N·y`, `dN/dδ`, and `N` times
 /// each interpolated number of a strip (`[stiffness, angle, z, radius, curvature_sum, ma, mb,
 /// k_over_e]`, as [`StripTable`] stores them).
@@ -270,54 +287,35 @@ impl StripTable {
         self.strips.is_empty()
     }
 
-    /// The penetrated zones of wheel `k` (0 left, 1 right) between tabulated states `i` and
-    /// `i + 1` (fraction `t`), for a vertical approach `approach` of the wheelset centre below
-    /// the table's rigid height and a roll `roll` relative to the table's (m, rad). Returns up
-    /// to two patches (the deepest two zones; a third, rare, is added to the nearer) and the
-    /// least gap (negative: the deepest penetration), m.
-    pub fn patches(
-        &self,
-        i: usize,
-        t: f64,
-        k: usize,
-        approach: f64,
-        roll: f64,
-        material: &Material,
-    ) -> ([Option<PatchLoad>; 2], f64) {
+    /// The penetrated zones of a wheel placed on the table as `at` says. Returns up to two
+    /// patches (the deepest two zones; a third, rare, is added to the nearer) and the least
+    /// gap (negative: the deepest penetration), m.
+    pub fn patches(&self, at: &StripQuery, material: &Material) -> ([Option<PatchLoad>; 2], f64) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the CPU has AVX (checked just above).
-            return unsafe { self.patches_avx(i, t, k, approach, roll, material) };
+            return unsafe { self.patches_avx(at, material) };
         }
-        self.patches_lanes(i, t, k, approach, roll, material)
+        self.patches_lanes(at, material)
     }
 
     /// [`StripTable::patches`] compiled for AVX: the strips' eight numbers four lanes at a
     /// time, the same operations in the same order (no FMA), so the same bits.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    fn patches_avx(
-        &self,
-        i: usize,
-        t: f64,
-        k: usize,
-        approach: f64,
-        roll: f64,
-        material: &Material,
-    ) -> ([Option<PatchLoad>; 2], f64) {
-        self.patches_lanes(i, t, k, approach, roll, material)
+    fn patches_avx(&self, at: &StripQuery, material: &Material) -> ([Option<PatchLoad>; 2], f64) {
+        self.patches_lanes(at, material)
     }
 
     #[inline(always)]
-    fn patches_lanes(
-        &self,
-        i: usize,
-        t: f64,
-        k: usize,
-        approach: f64,
-        roll: f64,
-        material: &Material,
-    ) -> ([Option<PatchLoad>; 2], f64) {
+    fn patches_lanes(&self, at: &StripQuery, material: &Material) -> ([Option<PatchLoad>; 2], f64) {
+        let StripQuery {
+            i,
+            t,
+            k,
+            approach,
+            roll,
+        } = *at;
         let e_star = material.young / (1.0 - material.poisson * material.poisson);
         let (w0, w1) = (self.windows[i][k], self.windows[i + 1][k]);
         let mut j0 = w0.first.max(w1.first);
@@ -471,8 +469,15 @@ mod tests {
             for k in 0..2 {
                 for approach in [2e-5, 1e-4, 3.5e-4, 8e-4] {
                     for roll in [-2e-3, 0.0, 1.5e-3] {
-                        let fast = strips.patches(i, t, k, approach, roll, &material);
-                        let portable = strips.patches_lanes(i, t, k, approach, roll, &material);
+                        let at = super::StripQuery {
+                            i,
+                            t,
+                            k,
+                            approach,
+                            roll,
+                        };
+                        let fast = strips.patches(&at, &material);
+                        let portable = strips.patches_lanes(&at, &material);
                         assert_eq!(
                             format!("{fast:?}"),
                             format!("{portable:?}"),

@@ -14,6 +14,7 @@ pub mod validate;
 mod wheel_rail;
 
 pub use creep::{CreepContact, CreepForce, CreepLaw, Creepage};
+pub use elastic::{PatchLoad, StripQuery, StripTable};
 pub use geometry::{ContactState, Side, WheelContact, WheelsetGeometry};
 pub use hertz::{HertzEllipse, HertzShape, Material};
 pub use jacobian::patch_damping;

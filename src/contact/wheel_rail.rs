@@ -212,9 +212,14 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
     // Approach of the centre below the rigid height, and roll beyond the table's.
     let approach = z - w.height;
     let droll = w.roll - roll;
-    let (loads, gap) = table
-        .strips()
-        .patches(i, t, k, approach, droll, &model.material);
+    let at = super::StripQuery {
+        i,
+        t,
+        k,
+        approach,
+        roll: droll,
+    };
+    let (loads, gap) = table.strips().patches(&at, &model.material);
     let speed = w.speed.abs().max(CREEP_SPEED_FLOOR);
     let (sy, cy) = crate::angle::sin_cos(w.yaw);
     let (sr, cr) = crate::angle::sin_cos(droll);
