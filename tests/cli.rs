@@ -162,6 +162,32 @@ fn bench_simulate_needs_at_least_one_measurement() {
     assert!(ok && out.contains("fastest counts"), "{out}");
 }
 
+/// `--against` times another binary in alternate rounds (here the same one: a ratio near 1 is
+/// printed), and names the file when what it is given is not a railforce binary.
+#[test]
+fn bench_simulate_against_another_binary() {
+    let me = env!("CARGO_BIN_EXE_railforce");
+    let short = ["--repeat", "2", "--seconds", "0.05"];
+    let (ok, out, err) = railforce(
+        &["bench", "simulate", "--against", me]
+            .into_iter()
+            .chain(short)
+            .collect::<Vec<_>>(),
+    );
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("round 2:") && out.contains("median: physics") && out.contains("build:"),
+        "{out}"
+    );
+    let (ok, _, err) = railforce(
+        &["bench", "simulate", "--against", "no-such-railforce"]
+            .into_iter()
+            .chain(short)
+            .collect::<Vec<_>>(),
+    );
+    assert!(!ok && err.contains("--against no-such-railforce"), "{err}");
+}
+
 #[test]
 fn validate_contact_passes_on_the_built_in_reference_data_from_any_folder() {
     // Run from an empty folder: the reference data are built into the binary.

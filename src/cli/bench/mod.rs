@@ -1,5 +1,6 @@
 //! `railforce bench …`: built-in benchmarks.
 
+mod against;
 mod contact;
 mod learn;
 mod simulate;
@@ -75,6 +76,12 @@ enum What {
         /// Integration step, s (default: the integrator's own).
         #[arg(long)]
         dt: Option<f64>,
+        /// Another railforce binary (an older build, say) to time against this one: `--repeat`
+        /// rounds, each measuring both, in alternating order; prints each round and the
+        /// ratio of the medians (this build's speed-up). A shared machine's load then falls on
+        /// both alike.
+        #[arg(long, value_name = "BINARY")]
+        against: Option<std::path::PathBuf>,
     },
     /// Accuracy and speed against the integration step: the same run (default R 400 m, FRA
     /// class 5, 60 km/h, 15 s) at each step and at a finer reference step; every wheel's Y/Q
@@ -171,15 +178,41 @@ pub fn run(args: BenchArgs) -> Result<()> {
             repeat,
             integrator,
             dt,
+            against,
         } => {
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench simulate`");
             }
-            let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&vehicle)?)?;
+            let (vehicle, track) = (
+                super::builtin::resolve(&vehicle)?,
+                super::builtin::resolve(&track)?,
+            );
+            if let Some(other) = against {
+                let mut args: Vec<String> = vec![
+                    "--vehicle".into(),
+                    vehicle.display().to_string(),
+                    "--track".into(),
+                    track.display().to_string(),
+                    "--speed-kmh".into(),
+                    speed_kmh.to_string(),
+                    "--seconds".into(),
+                    seconds.to_string(),
+                ];
+                if let Some(i) = &integrator {
+                    args.extend(["--integrator".into(), i.clone()]);
+                }
+                if let Some(dt) = dt {
+                    args.extend(["--dt".into(), dt.to_string()]);
+                }
+                return ab_rounds(
+                    &vehicle, &track, speed_kmh, seconds, repeat, integrator, dt, &other, &args,
+                );
+            }
+            let v = railforce::vehicle::Vehicle::load(&vehicle)?;
             let t0 = std::time::Instant::now();
             v.contact.table();
             let table_s = t0.elapsed().as_secs_f64();
-            let tr = railforce::track::Track::load(&super::builtin::resolve(&track)?)?;
+            let tr = railforce::track::Track::load(&track)?;
             let default = railforce::sim::SimConfig::default();
             let stepping = railforce::sim::Stepping::chosen(integrator.as_deref(), dt);
             let base = railforce::sim::SimConfig {
@@ -298,4 +331,76 @@ pub fn run(args: BenchArgs) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// `bench simulate --against`: `rounds` alternating measurements of this build and `other`.
+#[allow(clippy::too_many_arguments)]
+fn ab_rounds(
+    vehicle: &std::path::Path,
+    track: &std::path::Path,
+    speed_kmh: f64,
+    seconds: f64,
+    rounds: u64,
+    integrator: Option<String>,
+    dt: Option<f64>,
+    other: &std::path::Path,
+    args: &[String],
+) -> Result<()> {
+    let v = railforce::vehicle::Vehicle::load(vehicle)?;
+    v.contact.table();
+    let tr = railforce::track::Track::load(track)?;
+    let stepping = railforce::sim::Stepping::chosen(integrator.as_deref(), dt);
+    let base = railforce::sim::SimConfig {
+        integrator: stepping.integrator,
+        dt: stepping.dt,
+        ..railforce::sim::SimConfig::default()
+    };
+    println!(
+        "simulation benchmark against {}: {} on {}, {speed_kmh} km/h, {seconds} s, {} step {} ms, {rounds} rounds alternating (µs per step, physics / all channels)",
+        other.display(),
+        v.name,
+        tr.spec().name,
+        stepping.integrator.name(),
+        stepping.dt * 1e3
+    );
+    let (mut this, mut that) = (Vec::new(), Vec::new());
+    for round in 0..rounds {
+        // Alternate which goes first, so neither always follows the other's warm-up.
+        let mine = |this: &mut Vec<(f64, f64)>| -> Result<()> {
+            this.push(simulate::once(&v, &tr, speed_kmh / 3.6, seconds, &base)?);
+            Ok(())
+        };
+        if round % 2 == 0 {
+            mine(&mut this)?;
+            that.push(against::other_once(other, args)?);
+        } else {
+            that.push(against::other_once(other, args)?);
+            mine(&mut this)?;
+        }
+        let (a, b) = (this[this.len() - 1], that[that.len() - 1]);
+        println!(
+            "  round {}: this {:.2} / {:.2}, the other {:.2} / {:.2}",
+            round + 1,
+            a.0,
+            a.1,
+            b.0,
+            b.1
+        );
+    }
+    let med = |v: &[(f64, f64)], k: usize| {
+        against::median(
+            &v.iter()
+                .map(|x| if k == 0 { x.0 } else { x.1 })
+                .collect::<Vec<_>>(),
+        )
+    };
+    let (p, q) = (med(&this, 0), med(&that, 0));
+    let (r, s) = (med(&this, 1), med(&that, 1));
+    println!(
+        "  median: physics {p:.2} against {q:.2} µs ({:.3}× the other's speed), all channels {r:.2} against {s:.2} µs ({:.3}×)",
+        q / p,
+        s / r
+    );
+    println!("  build: {}", railforce::sim::profile::vector_build());
+    Ok(())
 }

@@ -31,6 +31,49 @@ pub struct SimulateBench {
     pub elements: Vec<(&'static str, usize, f64)>,
 }
 
+/// One measurement of each kind: `steps` steps physics only, then with the recorder; wall
+/// seconds of each.
+fn measure(vehicle: &Vehicle, track: &Track, cfg: &SimConfig, steps: usize) -> Result<(f64, f64)> {
+    let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
+    let t = Instant::now();
+    for _ in 0..steps {
+        sim.step()?;
+    }
+    let plain = t.elapsed().as_secs_f64();
+    let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
+    let mut rec = Recorder::new(&sim);
+    let mut acc = 0.0;
+    let t = Instant::now();
+    for _ in 0..steps {
+        sim.step()?;
+        if let Some(row) = rec.sample(&mut sim) {
+            acc += row[2];
+        }
+    }
+    std::hint::black_box(acc);
+    Ok((plain, t.elapsed().as_secs_f64()))
+}
+
+/// µs per step physics only and with all channels, one measurement of each (the A/B rounds of
+/// `bench simulate --against`).
+pub fn once(
+    vehicle: &Vehicle,
+    track: &Track,
+    speed: f64,
+    seconds: f64,
+    base: &SimConfig,
+) -> Result<(f64, f64)> {
+    let cfg = SimConfig {
+        speed,
+        duration: seconds,
+        settle: 0.0,
+        ..base.clone()
+    };
+    let steps = (seconds / cfg.dt).round().max(1.0) as usize;
+    let (p, r) = measure(vehicle, track, &cfg, steps)?;
+    Ok((p * 1e6 / steps as f64, r * 1e6 / steps as f64))
+}
+
 /// Runs `seconds` of simulated time physics only, then with the recorder, `repeats` times in
 /// turn at `speed` on `track`, with the step and integrator of `base`; the fastest of each
 /// counts (a run only ever gets slower from what else the machine does).
@@ -58,24 +101,9 @@ pub fn run(
     let steps = (seconds / dt).round() as usize;
     let (mut plain, mut recorded) = (Vec::new(), Vec::new());
     for _ in 0..repeats.max(1) {
-        let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
-        let t = Instant::now();
-        for _ in 0..steps {
-            sim.step()?;
-        }
-        plain.push(t.elapsed().as_secs_f64());
-        let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
-        let mut rec = Recorder::new(&sim);
-        let mut acc = 0.0;
-        let t = Instant::now();
-        for _ in 0..steps {
-            sim.step()?;
-            if let Some(row) = rec.sample(&mut sim) {
-                acc += row[2];
-            }
-        }
-        std::hint::black_box(acc);
-        recorded.push(t.elapsed().as_secs_f64());
+        let (p, r) = measure(vehicle, track, &cfg, steps)?;
+        plain.push(p);
+        recorded.push(r);
     }
     let fastest = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
     let slowest = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
