@@ -307,6 +307,7 @@ impl StripTable {
         self.patches_lanes(at, material)
     }
 
+    /// The body of [`StripTable::patches`], inlined into the portable and the AVX build.
     #[inline(always)]
     fn patches_lanes(&self, at: &StripQuery, material: &Material) -> ([Option<PatchLoad>; 2], f64) {
         let StripQuery {
