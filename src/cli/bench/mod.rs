@@ -401,6 +401,18 @@ fn ab_rounds(
         q / p,
         s / r
     );
+    let low = |v: &[(f64, f64)], k: usize| {
+        v.iter()
+            .map(|x| if k == 0 { x.0 } else { x.1 })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (p, q) = (low(&this, 0), low(&that, 0));
+    let (r, s) = (low(&this, 1), low(&that, 1));
+    println!(
+        "  fastest: physics {p:.2} against {q:.2} µs ({:.3}×), all channels {r:.2} against {s:.2} µs ({:.3}×)",
+        q / p,
+        s / r
+    );
     println!("  build: {}", railforce::sim::profile::vector_build());
     Ok(())
 }
