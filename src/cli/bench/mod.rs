@@ -387,32 +387,23 @@ fn ab_rounds(
             b.1
         );
     }
-    let med = |v: &[(f64, f64)], k: usize| {
-        against::median(
-            &v.iter()
-                .map(|x| if k == 0 { x.0 } else { x.1 })
-                .collect::<Vec<_>>(),
-        )
+    // Physics-only and recorded µs of each side, then the two summaries of each.
+    let column = |v: &[(f64, f64)], k: usize| -> Vec<f64> {
+        v.iter().map(|x| if k == 0 { x.0 } else { x.1 }).collect()
     };
-    let (p, q) = (med(&this, 0), med(&that, 0));
-    let (r, s) = (med(&this, 1), med(&that, 1));
-    println!(
-        "  median: physics {p:.2} against {q:.2} µs ({:.3}× the other's speed), all channels {r:.2} against {s:.2} µs ({:.3}×)",
-        q / p,
-        s / r
-    );
-    let low = |v: &[(f64, f64)], k: usize| {
-        v.iter()
-            .map(|x| if k == 0 { x.0 } else { x.1 })
-            .fold(f64::INFINITY, f64::min)
-    };
-    let (p, q) = (low(&this, 0), low(&that, 0));
-    let (r, s) = (low(&this, 1), low(&that, 1));
-    println!(
-        "  fastest: physics {p:.2} against {q:.2} µs ({:.3}×), all channels {r:.2} against {s:.2} µs ({:.3}×)",
-        q / p,
-        s / r
-    );
+    let fastest = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    for (name, stat) in [
+        ("median", against::median as fn(&[f64]) -> f64),
+        ("fastest", fastest),
+    ] {
+        let [p, q, r, s] =
+            [(&this, 0), (&that, 0), (&this, 1), (&that, 1)].map(|(v, k)| stat(&column(v, k)));
+        println!(
+            "  {name}: physics {p:.2} against {q:.2} µs ({:.3}× the other's speed), all channels {r:.2} against {s:.2} µs ({:.3}×)",
+            q / p,
+            s / r
+        );
+    }
     println!("  build: {}", railforce::sim::profile::vector_build());
     Ok(())
 }
