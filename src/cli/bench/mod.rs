@@ -187,6 +187,18 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 super::builtin::resolve(&vehicle)?,
                 super::builtin::resolve(&track)?,
             );
+            let v = railforce::vehicle::Vehicle::load(&vehicle)?;
+            let t0 = std::time::Instant::now();
+            v.contact.table();
+            let table_s = t0.elapsed().as_secs_f64();
+            let tr = railforce::track::Track::load(&track)?;
+            let default = railforce::sim::SimConfig::default();
+            let stepping = railforce::sim::Stepping::chosen(integrator.as_deref(), dt);
+            let base = railforce::sim::SimConfig {
+                integrator: stepping.integrator,
+                dt: stepping.dt,
+                ..default.clone()
+            };
             if let Some(other) = against {
                 let mut args: Vec<String> = vec![
                     "--vehicle".into(),
@@ -204,22 +216,8 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 if let Some(dt) = dt {
                     args.extend(["--dt".into(), dt.to_string()]);
                 }
-                return ab_rounds(
-                    &vehicle, &track, speed_kmh, seconds, repeat, integrator, dt, &other, &args,
-                );
+                return ab_rounds(&v, &tr, speed_kmh, seconds, repeat, &base, &other, &args);
             }
-            let v = railforce::vehicle::Vehicle::load(&vehicle)?;
-            let t0 = std::time::Instant::now();
-            v.contact.table();
-            let table_s = t0.elapsed().as_secs_f64();
-            let tr = railforce::track::Track::load(&track)?;
-            let default = railforce::sim::SimConfig::default();
-            let stepping = railforce::sim::Stepping::chosen(integrator.as_deref(), dt);
-            let base = railforce::sim::SimConfig {
-                integrator: stepping.integrator,
-                dt: stepping.dt,
-                ..default.clone()
-            };
             let repeat = repeat as usize;
             let b = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, repeat, &base)?;
             println!(
@@ -333,49 +331,37 @@ pub fn run(args: BenchArgs) -> Result<()> {
     }
 }
 
-/// `bench simulate --against`: `rounds` alternating measurements of this build and `other`.
+/// `bench simulate --against`: `rounds` alternating measurements of this build and `other`
+/// (run with `args`: the same vehicle, track, speed, duration and stepping).
 #[allow(clippy::too_many_arguments)]
 fn ab_rounds(
-    vehicle: &std::path::Path,
-    track: &std::path::Path,
+    v: &railforce::vehicle::Vehicle,
+    tr: &railforce::track::Track,
     speed_kmh: f64,
     seconds: f64,
     rounds: u64,
-    integrator: Option<String>,
-    dt: Option<f64>,
+    base: &railforce::sim::SimConfig,
     other: &std::path::Path,
     args: &[String],
 ) -> Result<()> {
-    let v = railforce::vehicle::Vehicle::load(vehicle)?;
-    v.contact.table();
-    let tr = railforce::track::Track::load(track)?;
-    let stepping = railforce::sim::Stepping::chosen(integrator.as_deref(), dt);
-    let base = railforce::sim::SimConfig {
-        integrator: stepping.integrator,
-        dt: stepping.dt,
-        ..railforce::sim::SimConfig::default()
-    };
     println!(
         "simulation benchmark against {}: {} on {}, {speed_kmh} km/h, {seconds} s, {} step {} ms, {rounds} rounds alternating (µs per step, physics / all channels)",
         other.display(),
         v.name,
         tr.spec().name,
-        stepping.integrator.name(),
-        stepping.dt * 1e3
+        base.integrator.name(),
+        base.dt * 1e3
     );
     let (mut this, mut that) = (Vec::new(), Vec::new());
     for round in 0..rounds {
         // Alternate which goes first, so neither always follows the other's warm-up.
-        let mine = |this: &mut Vec<(f64, f64)>| -> Result<()> {
-            this.push(simulate::once(&v, &tr, speed_kmh / 3.6, seconds, &base)?);
-            Ok(())
-        };
+        let mine = || simulate::once(v, tr, speed_kmh / 3.6, seconds, base);
         if round % 2 == 0 {
-            mine(&mut this)?;
+            this.push(mine()?);
             that.push(against::other_once(other, args)?);
         } else {
             that.push(against::other_once(other, args)?);
-            mine(&mut this)?;
+            this.push(mine()?);
         }
         let (a, b) = (this[this.len() - 1], that[that.len() - 1]);
         println!(

@@ -54,6 +54,19 @@ fn measure(vehicle: &Vehicle, track: &Track, cfg: &SimConfig, steps: usize) -> R
     Ok((plain, t.elapsed().as_secs_f64()))
 }
 
+/// The configuration of a timed run (`base`'s stepping at `speed`, `seconds` long, no
+/// settling) and its number of steps.
+fn timed_run(base: &SimConfig, speed: f64, seconds: f64) -> (SimConfig, usize) {
+    let cfg = SimConfig {
+        speed,
+        duration: seconds,
+        settle: 0.0,
+        ..base.clone()
+    };
+    let steps = (seconds / cfg.dt).round().max(1.0) as usize;
+    (cfg, steps)
+}
+
 /// µs per step physics only and with all channels, one measurement of each (the A/B rounds of
 /// `bench simulate --against`).
 pub fn once(
@@ -63,13 +76,7 @@ pub fn once(
     seconds: f64,
     base: &SimConfig,
 ) -> Result<(f64, f64)> {
-    let cfg = SimConfig {
-        speed,
-        duration: seconds,
-        settle: 0.0,
-        ..base.clone()
-    };
-    let steps = (seconds / cfg.dt).round().max(1.0) as usize;
+    let (cfg, steps) = timed_run(base, speed, seconds);
     let (p, r) = measure(vehicle, track, &cfg, steps)?;
     Ok((p * 1e6 / steps as f64, r * 1e6 / steps as f64))
 }
@@ -85,20 +92,8 @@ pub fn run(
     repeats: usize,
     base: &SimConfig,
 ) -> Result<SimulateBench> {
-    let cfg = SimConfig {
-        speed,
-        duration: seconds,
-        settle: 0.0,
-        ..base.clone()
-    };
+    let (cfg, steps) = timed_run(base, speed, seconds);
     let dt = cfg.dt;
-    let cfg_profiled = |speed, duration| SimConfig {
-        speed,
-        duration,
-        settle: 0.0,
-        ..base.clone()
-    };
-    let steps = (seconds / dt).round() as usize;
     let (mut plain, mut recorded) = (Vec::new(), Vec::new());
     for _ in 0..repeats.max(1) {
         let (p, r) = measure(vehicle, track, &cfg, steps)?;
@@ -112,7 +107,7 @@ pub fn run(
     // Profiled: the same run with the clock read around every part of the step, and around
     // the recorder.
     let clock = railforce::sim::profile::clock_cost_ns();
-    let mut sim = Simulation::new(vehicle, track, cfg_profiled(speed, seconds))?;
+    let mut sim = Simulation::new(vehicle, track, cfg.clone())?;
     let mut rec = Recorder::new(&sim);
     sim.set_profiling(true);
     rec.set_profiling(true);
