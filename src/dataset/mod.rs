@@ -290,6 +290,12 @@ pub fn generate(
                  support implicit, fixed step (src/sim/integrator.rs)"
                     .into()
             }
+            crate::sim::Integrator::LinearlyImplicitHertz => {
+                "linearly implicit with the contact's Hertz spring: as linearly implicit, and the \
+                 contact's normal stiffness at Fox and Goodwin's share (1/12 of dt^2 K) with the \
+                 rail surface's passing, fixed step (src/sim/integrator.rs)"
+                    .into()
+            }
             crate::sim::Integrator::Heun => {
                 "Heun's method (explicit trapezoidal, second order), fixed step \
                  (src/sim/integrator.rs)"

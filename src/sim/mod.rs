@@ -156,6 +156,9 @@ pub struct Simulation<'a> {
     /// Per wheel: the contact's damping and normal stiffness on the rail's lateral and
     /// vertical motion, track axes (the linearly implicit step's).
     rail_coupling: Vec<RailCoupling>,
+    /// Per wheel: the rail surface's rate under it at the last step, track `(ẏ, ż)` (the
+    /// linearly implicit step's; none before the first).
+    surface_rates: Vec<Option<nalgebra::Vector2<f64>>>,
 }
 
 impl<'a> Simulation<'a> {
@@ -303,6 +306,7 @@ impl<'a> Simulation<'a> {
             rail_force: vec![[0.0, -static_load]; n_wheels],
             contact_damping: vec![nalgebra::Matrix6::zeros(); vehicle.contact.wheelsets.len()],
             rail_coupling: vec![RailCoupling::default(); n_wheels],
+            surface_rates: vec![None; n_wheels],
             inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
             hauling_integral: 0.0,

@@ -6,7 +6,7 @@
 use super::Simulation;
 use crate::contact::{Creepage, Side, WheelOnRail, evaluate};
 use crate::error::Result;
-use nalgebra::Vector3;
+use nalgebra::{Matrix6, Vector3};
 
 /// What happened at one wheel in the last step.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -53,9 +53,10 @@ pub struct RailState {
     pub vz: f64,
 }
 
-/// The contact's damping between one wheel and its rail mass, linearised (the linearly
-/// implicit step's): on the rail's lateral and vertical motion (track axes), and across to the
-/// wheelset's.
+/// The contact between one wheel and its rail mass, linearised for the linearly implicit step:
+/// its damping and stiffness share on the rail's lateral and vertical motion (track axes) and
+/// across to the wheelset's, and how the rail surface's own rise under the rolling wheel (the
+/// irregularity's rate) pushes both through the contact's normal law.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(super) struct RailCoupling {
     /// On the rail's own motion (`Pᵀ·D_k·P`), track axes.
@@ -66,27 +67,39 @@ pub(super) struct RailCoupling {
     /// How the rail's velocity change (track `Δy, Δz`) pushes the wheelset through it
     /// (`D_k·P`, world wrench).
     pub from_rail: nalgebra::SMatrix<f64, 6, 2>,
+    /// How a change of the rail surface's rate under the wheel (track `Δẏ, Δż` of the
+    /// irregularity) pushes the wheelset through the normal law's share in the step
+    /// (`G_k·P`, world wrench per m/s, with `G_k = θ·c_n + α·Δt·k_n` along the normal).
+    pub from_surface: nalgebra::SMatrix<f64, 6, 2>,
+    /// The same on the rail (`Pᵀ·G_k·P`, track axes), with the opposite sign.
+    pub surface_on_rail: nalgebra::Matrix2<f64>,
 }
 
 impl RailCoupling {
-    /// The coupling of one wheel's damping `d` (track axes, about the wheelset's centre, as
-    /// [`crate::contact::patch_damping`] sums it) with its rail, the track's axes `a` (track
-    /// to world). The rail's velocity enters the wheel's relative velocity as minus a
-    /// wheelset translation along track y and z (`wheels_on_rails`), so
-    /// `P = [A·e_y, A·e_z; 0, 0]` maps it to the wheelset's world coordinates.
-    pub(super) fn new(d: &nalgebra::Matrix6<f64>, a: &nalgebra::Matrix3<f64>) -> Self {
+    /// The coupling of one wheel's damping `d` and normal share `g` (track axes, about the
+    /// wheelset's centre, as [`crate::contact::patch_damping`] sums it) with its rail, the
+    /// track's axes `a` (track to world). The rail's velocity enters the wheel's relative
+    /// velocity as minus a wheelset translation along track y and z (`wheels_on_rails`), as
+    /// does the irregularity's rate in the approach, so `P = [A·e_y, A·e_z; 0, 0]` maps either
+    /// to the wheelset's world coordinates.
+    pub(super) fn new(
+        d: &nalgebra::Matrix6<f64>,
+        g: &nalgebra::Matrix6<f64>,
+        a: &nalgebra::Matrix3<f64>,
+    ) -> Self {
         let mut c = RailCoupling {
             damping: d.fixed_view::<2, 2>(1, 1).into_owned(),
+            surface_on_rail: g.fixed_view::<2, 2>(1, 1).into_owned(),
             ..RailCoupling::default()
         };
         for j in 0..2 {
-            let col = d.column(1 + j).into_owned();
-            c.from_rail
-                .fixed_view_mut::<3, 1>(0, j)
-                .copy_from(&(a * col.fixed_rows::<3>(0)));
-            c.from_rail
-                .fixed_view_mut::<3, 1>(3, j)
-                .copy_from(&(a * col.fixed_rows::<3>(3)));
+            for (m, to) in [(d, &mut c.from_rail), (g, &mut c.from_surface)] {
+                let col = m.column(1 + j).into_owned();
+                to.fixed_view_mut::<3, 1>(0, j)
+                    .copy_from(&(a * col.fixed_rows::<3>(0)));
+                to.fixed_view_mut::<3, 1>(3, j)
+                    .copy_from(&(a * col.fixed_rows::<3>(3)));
+            }
             let row = d.row(1 + j);
             let lin = row.fixed_columns::<3>(0) * a.transpose();
             let ang = row.fixed_columns::<3>(3) * a.transpose();
@@ -153,7 +166,7 @@ impl Simulation<'_> {
         let v = self.vehicle;
         let cs = &v.contact;
         let model = cs.model();
-        let implicit = self.cfg.integrator == super::Integrator::LinearlyImplicit;
+        let shares = self.cfg.integrator.shares(self.cfg.dt);
         for (w, &b) in cs.wheelsets.iter().enumerate() {
             let f = self.frames[b];
             let (inputs, y_centre) = self.wheels_on_rails(w);
@@ -166,12 +179,21 @@ impl Simulation<'_> {
                     evaluate(self.table, &model, &wr)
                 );
                 self.inputs[idx] = wr;
-                if implicit {
-                    let mut wheel = nalgebra::Matrix6::zeros();
+                if let Some(super::integrator::Shares { theta, alpha_dt }) = shares {
+                    // The step's share of the contact: θ·Δt·D + α·Δt²·K, written as one damping
+                    // D + (α·Δt/θ)·K; G the normal law's part (damping and Hertz spring).
+                    let (mut wheel, mut normal) = (Matrix6::zeros(), Matrix6::zeros());
                     for p in out.patches.iter().flatten() {
                         wheel += crate::contact::patch_damping(p, &model, wr.speed);
+                        if alpha_dt > 0.0 {
+                            wheel += crate::contact::patch_stiffness(p) * (alpha_dt / theta);
+                            normal += crate::contact::patch_normal(
+                                p,
+                                theta * p.damping + alpha_dt * p.stiffness,
+                            );
+                        }
                     }
-                    self.rail_coupling[idx] = RailCoupling::new(&wheel, &f.axes);
+                    self.rail_coupling[idx] = RailCoupling::new(&wheel, &normal, &f.axes);
                     damping += wheel;
                 }
                 let force = f.axes * Vector3::from(out.force);
@@ -202,7 +224,7 @@ impl Simulation<'_> {
                     },
                 };
             }
-            if implicit {
+            if shares.is_some() {
                 // Track axes to world: blocks A·D·Aᵀ.
                 let a = f.axes;
                 let mut world = nalgebra::Matrix6::zeros();
@@ -225,7 +247,7 @@ impl Simulation<'_> {
             return;
         };
         let dt = self.cfg.dt;
-        if self.cfg.integrator == super::Integrator::LinearlyImplicit {
+        if self.cfg.integrator.implicit() {
             return;
         }
         for (r, f) in self.rails.iter_mut().zip(&self.rail_force) {
