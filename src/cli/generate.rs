@@ -39,14 +39,15 @@ pub struct GenerateArgs {
     /// Settling time of each run, s (not written).
     #[arg(long, default_value_t = 3.0)]
     settle: f64,
-    /// Integrator of every run (default: linearly-implicit): `linearly-implicit` (the
-    /// wheel–rail damping, each wheelset with its rail masses, implicit; see `railforce bench
-    /// step`), `semi-implicit` (explicit in every force) or `heun` (second order, explicit, for
-    /// small steps). Recorded in the manifest; a data set resumes only with the same choice.
+    /// Integrator of every run (default: linearly-implicit-hertz): `linearly-implicit-hertz`
+    /// (the wheel–rail damping and the contact's Hertz spring, each wheelset with its rail
+    /// masses, implicit; see `railforce bench step`), `linearly-implicit` (the damping alone),
+    /// `semi-implicit` (explicit in every force) or `heun` (second order, explicit, for small
+    /// steps). Recorded in the manifest; a data set resumes only with the same choice.
     #[arg(long, value_parser = railforce::sim::Integrator::NAMES)]
     integrator: Option<String>,
-    /// Integration step of every run, s (default: the integrator's own, 0.5 ms linearly
-    /// implicit, 0.2 ms semi-implicit or Heun).
+    /// Integration step of every run, s (default: the integrator's own, 5/7 ms linearly
+    /// implicit Hertz, 0.5 ms linearly implicit, 0.2 ms semi-implicit or Heun).
     #[arg(long)]
     dt: Option<f64>,
     /// Join the shard manifests in --out into manifest.json instead of generating.

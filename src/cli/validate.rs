@@ -60,7 +60,7 @@ enum What {
     /// forces on R 400 m at 60 km/h and R 800 m at 100 km/h, Klingel's wavelength of a free
     /// wheelset and Wickens' critical speed of a restrained one; then fidelity: the
     /// anti-alias filter at the output's Nyquist frequency, wheel-force power above 40 Hz in
-    /// the R 400 m curve, convergence in the step (0.2 against 0.05 ms), a smooth s_m, the
+    /// the R 400 m curve, convergence in the step (the default step against a quarter of it), a smooth s_m, the
     /// side frames' roll (class 5, tangent at 80 and R 400 m at 60 km/h, loaded and empty:
     /// std ≤ 8 mrad, peak ≤ 25 mrad); the critical speeds of the loaded and the empty wagon
     /// by kink-and-coast and by run-down (a large kick at 200 km/h, then slowing) at the

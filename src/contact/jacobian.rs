@@ -24,6 +24,18 @@ use nalgebra::{Matrix3, Matrix6, Vector3};
 /// `c_y = r·G·a·b·c22/V`), spin on the lateral force (`s = r·G·(ab)^{3/2}·c23/V`), with `r` the
 /// law's saturation (1 unsaturated), and the normal damping `c_n` along the normal.
 pub fn patch_damping(p: &PatchForce, model: &ContactModel, speed: f64) -> Matrix6<f64> {
+    patch_damping_with_spring(p, model, speed, 0.0)
+}
+
+/// [`patch_damping`] with `spring` seconds of the patch's normal stiffness added along its
+/// normal (`D + spring·K`, [`patch_stiffness`]): the linearly implicit step's `θ·Δt·D +
+/// α·Δt²·K` over `θ·Δt` in one matrix. With `spring` 0 it is `patch_damping` to the bit.
+pub fn patch_damping_with_spring(
+    p: &PatchForce,
+    model: &ContactModel,
+    speed: f64,
+    spring: f64,
+) -> Matrix6<f64> {
     let (a, b) = (p.ellipse.a, p.ellipse.b);
     let v = speed.abs().max(super::CREEP_SPEED_FLOOR);
     let (tx, ty, n) = (
@@ -31,7 +43,7 @@ pub fn patch_damping(p: &PatchForce, model: &ContactModel, speed: f64) -> Matrix
         Vector3::from(p.frame.ty),
         Vector3::from(p.frame.n),
     );
-    let mut c = n * n.transpose() * p.damping;
+    let mut c = n * n.transpose() * (p.damping + spring * p.stiffness);
     let mut spin = Matrix3::zeros();
     if a > 0.0 && b > 0.0 && p.normal > 0.0 {
         let k = p.kalker;
@@ -60,15 +72,17 @@ pub fn patch_damping(p: &PatchForce, model: &ContactModel, speed: f64) -> Matrix
 /// creep forces with the displacement (gravitational stiffness, hundreds of times softer) is
 /// left out.
 pub fn patch_stiffness(p: &PatchForce) -> Matrix6<f64> {
-    patch_normal(p, p.stiffness)
+    let n = Vector3::from(p.frame.n);
+    at_point(n * n.transpose() * p.stiffness, Matrix3::zeros(), p.point)
 }
 
-/// A coefficient `c` along the patch's normal at its load centre, moved to the wheelset centre
-/// as [`patch_damping`] and [`patch_stiffness`] are: `d[F; M] = −c·J·Jᵀ·d[x; θ]` with
-/// `J = [n; p × n]`.
-pub fn patch_normal(p: &PatchForce, c: f64) -> Matrix6<f64> {
+/// `J = [n; p × n]`, track axes: the patch's normal approach rate is `Jᵀ·[v; ω]` for the
+/// wheelset centre's velocity and angular velocity, and a normal load `N` acts on the wheelset as
+/// the wrench `N·J` (force and moment about its centre).
+pub fn patch_normal(p: &PatchForce) -> nalgebra::Vector6<f64> {
     let n = Vector3::from(p.frame.n);
-    at_point(n * n.transpose() * c, Matrix3::zeros(), p.point)
+    let m = Vector3::from(p.point).cross(&n);
+    nalgebra::Vector6::new(n.x, n.y, n.z, m.x, m.y, m.z)
 }
 
 /// A point's 3×3 law (`dF = −C·dv_c − S·dω`) moved to the wheelset centre, with `v_c = v + ω × p`.

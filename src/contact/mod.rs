@@ -17,7 +17,7 @@ pub use creep::{CreepContact, CreepForce, CreepLaw, Creepage};
 pub use elastic::{PatchLoad, StripQuery, StripTable};
 pub use geometry::{ContactState, Side, WheelContact, WheelsetGeometry};
 pub use hertz::{HertzEllipse, HertzShape, Material};
-pub use jacobian::{patch_damping, patch_normal, patch_stiffness};
+pub use jacobian::{patch_damping, patch_damping_with_spring, patch_normal, patch_stiffness};
 pub use kalker::KalkerCoefficients;
 pub use profile::Profile;
 pub use quasi_static::{QuasiStatic, StateResult, WheelResult, WheelsetState};

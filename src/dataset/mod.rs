@@ -292,7 +292,7 @@ pub fn generate(
             }
             crate::sim::Integrator::LinearlyImplicitHertz => {
                 "linearly implicit with the contact's Hertz spring: as linearly implicit, and the \
-                 contact's normal stiffness at Fox and Goodwin's share (1/12 of dt^2 K) with the \
+                 contact's normal stiffness at the share 0.1 of dt^2 K with the \
                  rail surface's passing, fixed step (src/sim/integrator.rs)"
                     .into()
             }

@@ -1,8 +1,9 @@
 //! Time-domain simulation of a vehicle on a track.
 //!
 //! Rigid bodies in the world frame (x, y horizontal, z up), integrated at a fixed step (default:
-//! linearly implicit in the wheel–rail damping at 0.5 ms, each wheelset solved with its rail
-//! masses; semi-implicit Euler at 0.2 ms selectable: `integrator`), gyroscopic terms included
+//! linearly implicit in the wheel–rail damping and the contact's Hertz spring at 5/7 ms, each
+//! wheelset solved with its rail masses; the same without the Hertz spring at 0.5 ms and
+//! semi-implicit Euler at 0.2 ms selectable: `integrator`), gyroscopic terms included
 //! (wheelsets spin).
 //! Every step the project computes all force elements and the wheel–rail contact from the body
 //! states and the track (curvature, cant, gradient, irregularities under each wheel). Signals
@@ -401,8 +402,8 @@ impl<'a> Simulation<'a> {
     /// let cfg = SimConfig { speed: 60.0 / 3.6, ..SimConfig::default() };
     /// let mut sim = Simulation::new(&vehicle, &track, cfg)?;
     /// sim.settle()?;
-    /// for _ in 0..2_000 {
-    ///     sim.step()?; // 1 s at the default 0.5 ms step
+    /// for _ in 0..1_400 {
+    ///     sim.step()?; // 1 s at the default 5/7 ms step
     /// }
     /// println!("Q of wheel 1L: {:.1} kN", sim.wheels[0].q / 1e3);
     /// # Ok::<(), railforce::Error>(())

@@ -76,30 +76,19 @@ pub(super) struct RailCoupling {
 }
 
 impl RailCoupling {
-    /// The coupling of one wheel's damping `d` and normal share `g` (track axes, about the
-    /// wheelset's centre, as [`crate::contact::patch_damping`] sums it) with its rail, the
-    /// track's axes `a` (track to world). The rail's velocity enters the wheel's relative
-    /// velocity as minus a wheelset translation along track y and z (`wheels_on_rails`), as
-    /// does the irregularity's rate in the approach, so `P = [A·e_y, A·e_z; 0, 0]` maps either
-    /// to the wheelset's world coordinates.
-    pub(super) fn new(
-        d: &nalgebra::Matrix6<f64>,
-        g: &nalgebra::Matrix6<f64>,
-        a: &nalgebra::Matrix3<f64>,
-    ) -> Self {
+    /// The coupling of one wheel's damping `d` (track axes, about the wheelset's centre, as
+    /// [`crate::contact::patch_damping`] sums it) with its rail, the track's axes `a` (track
+    /// to world). The rail's velocity enters the wheel's relative velocity as minus a
+    /// wheelset translation along track y and z (`wheels_on_rails`), so
+    /// `P = [A·e_y, A·e_z; 0, 0]` maps it to the wheelset's world coordinates.
+    pub(super) fn new(d: &nalgebra::Matrix6<f64>, a: &nalgebra::Matrix3<f64>) -> Self {
         let mut c = RailCoupling {
             damping: d.fixed_view::<2, 2>(1, 1).into_owned(),
-            surface_on_rail: g.fixed_view::<2, 2>(1, 1).into_owned(),
             ..RailCoupling::default()
         };
         for j in 0..2 {
-            for (m, to) in [(d, &mut c.from_rail), (g, &mut c.from_surface)] {
-                let col = m.column(1 + j).into_owned();
-                to.fixed_view_mut::<3, 1>(0, j)
-                    .copy_from(&(a * col.fixed_rows::<3>(0)));
-                to.fixed_view_mut::<3, 1>(3, j)
-                    .copy_from(&(a * col.fixed_rows::<3>(3)));
-            }
+            let col = d.column(1 + j).into_owned();
+            c.from_rail.set_column(j, &to_world(&col, a));
             let row = d.row(1 + j);
             let lin = row.fixed_columns::<3>(0) * a.transpose();
             let ang = row.fixed_columns::<3>(3) * a.transpose();
@@ -108,6 +97,27 @@ impl RailCoupling {
         }
         c
     }
+
+    /// Sets how the rail surface's rate pushes through the normal law's share: `g` is
+    /// `G_k·P` in track axes (`Σ g_p·J_p·[n_y, n_z]` over the patches, `J_p` from
+    /// [`crate::contact::patch_normal`]), `a` the track's axes.
+    pub(super) fn set_surface(
+        &mut self,
+        g: &nalgebra::SMatrix<f64, 6, 2>,
+        a: &nalgebra::Matrix3<f64>,
+    ) {
+        for j in 0..2 {
+            self.from_surface
+                .set_column(j, &to_world(&g.column(j).into_owned(), a));
+        }
+        self.surface_on_rail = g.fixed_view::<2, 2>(1, 0).into_owned();
+    }
+}
+
+/// A wrench in track axes `(F, M)` in world axes.
+fn to_world(w: &nalgebra::Vector6<f64>, a: &nalgebra::Matrix3<f64>) -> nalgebra::Vector6<f64> {
+    let (f, m) = (a * w.fixed_rows::<3>(0), a * w.fixed_rows::<3>(3));
+    nalgebra::Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
 }
 
 impl Simulation<'_> {
@@ -181,19 +191,29 @@ impl Simulation<'_> {
                 self.inputs[idx] = wr;
                 if let Some(super::integrator::Shares { theta, alpha_dt }) = shares {
                     // The step's share of the contact: θ·Δt·D + α·Δt²·K, written as one damping
-                    // D + (α·Δt/θ)·K; G the normal law's part (damping and Hertz spring).
-                    let (mut wheel, mut normal) = (Matrix6::zeros(), Matrix6::zeros());
+                    // D + (α·Δt/θ)·K; and the normal law's share G = θ·c_n + α·Δt·k_n on the
+                    // rail surface's rate (rank one per patch: g·J·Jᵀ, of which the columns of
+                    // the track's y and z).
+                    let mut wheel = Matrix6::zeros();
+                    let mut surface = nalgebra::SMatrix::<f64, 6, 2>::zeros();
                     for p in out.patches.iter().flatten() {
-                        wheel += crate::contact::patch_damping(p, &model, wr.speed);
+                        wheel += crate::contact::patch_damping_with_spring(
+                            p,
+                            &model,
+                            wr.speed,
+                            alpha_dt / theta,
+                        );
                         if alpha_dt > 0.0 {
-                            wheel += crate::contact::patch_stiffness(p) * (alpha_dt / theta);
-                            normal += crate::contact::patch_normal(
-                                p,
-                                theta * p.damping + alpha_dt * p.stiffness,
-                            );
+                            let j = crate::contact::patch_normal(p);
+                            let g = theta * p.damping + alpha_dt * p.stiffness;
+                            surface += j * nalgebra::RowVector2::new(j[1] * g, j[2] * g);
                         }
                     }
-                    self.rail_coupling[idx] = RailCoupling::new(&wheel, &normal, &f.axes);
+                    let mut coupling = RailCoupling::new(&wheel, &f.axes);
+                    if alpha_dt > 0.0 {
+                        coupling.set_surface(&surface, &f.axes);
+                    }
+                    self.rail_coupling[idx] = coupling;
                     damping += wheel;
                 }
                 let force = f.axes * Vector3::from(out.force);

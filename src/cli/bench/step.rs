@@ -25,13 +25,18 @@ pub struct StepArgs {
     #[arg(long, default_value_t = 5e-5)]
     reference: f64,
     /// Steps compared with it, s, comma separated.
-    #[arg(long, value_delimiter = ',', default_value = "2e-4,3e-4,4e-4,5e-4")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "2.5e-4,5e-4,6.25e-4,7.142857142857143e-4"
+    )]
     steps: Vec<f64>,
     /// Take the rails as rigid (drop the track file's `[rail_support]`): separates the
     /// rail masses' part in the step limit from the vehicle's.
     #[arg(long)]
     rigid_rails: bool,
-    /// Integrator of the compared steps (default: the default integrator, linearly implicit).
+    /// Integrator of the compared steps (default: the default integrator, linearly implicit
+    /// with the contact's Hertz spring).
     #[arg(long, value_parser = Integrator::NAMES)]
     integrator: Option<String>,
     /// Integrator of the reference (default semi-implicit: at 0.05 ms, issue 37's yardstick,
