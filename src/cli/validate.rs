@@ -60,9 +60,9 @@ enum What {
     /// forces on R 400 m at 60 km/h and R 800 m at 100 km/h, Klingel's wavelength of a free
     /// wheelset and Wickens' critical speed of a restrained one; then fidelity: the
     /// anti-alias filter at the output's Nyquist frequency, wheel-force power above 40 Hz in
-    /// the R 400 m curve, convergence in the step (the default step against a quarter of it), a smooth s_m, the
-    /// side frames' roll (class 5, tangent at 80 and R 400 m at 60 km/h, loaded and empty:
-    /// std ≤ 8 mrad, peak ≤ 25 mrad); the critical speeds of the loaded and the empty wagon
+    /// the R 400 m curve, convergence in the step (the default step against a quarter of
+    /// it), a smooth s_m, the side frames' roll (class 5, tangent at 80 and R 400 m at
+    /// 60 km/h, loaded and empty: std ≤ 8 mrad, peak ≤ 25 mrad); the critical speeds of the loaded and the empty wagon
     /// by kink-and-coast and by run-down (a large kick at 200 km/h, then slowing) at the
     /// files' flange back and at 1 356 and 1 360 mm (reported, with their order); last,
     /// what is left of the kink after 35 s held at 90 and 120 km/h. Prints measured against

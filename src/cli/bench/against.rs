@@ -7,18 +7,18 @@ use anyhow::{Context, Result, bail};
 use std::path::Path;
 use std::process::Command;
 
-/// The µs per step that a `bench simulate` printed, physics only and with all channels (the
-/// lines `physics only: X µs per step …` and `with all channels: Y µs per step …`, which
-/// every railforce since 2026-11 prints).
+/// The real-time factors that a `bench simulate` printed, physics only and with all channels
+/// (the lines `physics only: … X× real time` and `with all channels: … Y× real time …`, which
+/// every railforce since 2026-11 prints). Real time, not µs per step: the two binaries may
+/// step at different steps (their own defaults).
 fn parse(stdout: &str) -> Option<(f64, f64)> {
     let number = |key: &str| -> Option<f64> {
         let line = stdout.lines().find(|l| l.trim_start().starts_with(key))?;
-        line.split_once(':')?
-            .1
-            .split_whitespace()
-            .next()?
-            .parse()
-            .ok()
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let at = words
+            .windows(2)
+            .position(|w| w[0].ends_with('×') && w[1] == "real")?;
+        words[at].trim_end_matches('×').parse().ok()
     };
     Some((number("physics only:")?, number("with all channels:")?))
 }
@@ -61,11 +61,11 @@ pub fn median(v: &[f64]) -> f64 {
 mod tests {
     use super::*;
 
-    /// The numbers come from the two lines, whatever surrounds them.
+    /// The real-time factors come from the two lines, whatever surrounds them.
     #[test]
     fn reads_the_two_lines_of_a_bench_simulate() {
         let out = "simulation benchmark: C80 …\n  physics only:        11.49 µs per step (slowest 12.88),  43.5× real time\n  with all channels:   13.32 µs per step,  37.5× real time (recording costs 16 %)\n";
-        assert_eq!(parse(out), Some((11.49, 13.32)));
+        assert_eq!(parse(out), Some((43.5, 37.5)));
         assert_eq!(parse("physics only: 1 µs\n"), None);
         assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);

@@ -77,9 +77,10 @@ enum What {
         #[arg(long)]
         dt: Option<f64>,
         /// Another railforce binary (an older build, say) to time against this one: `--repeat`
-        /// rounds, each measuring both, in alternating order; prints each round and the
-        /// ratio of the medians (this build's speed-up). A shared machine's load then falls on
-        /// both alike.
+        /// rounds, each measuring both, in alternating order; prints each round's real-time
+        /// factors and the ratio of the medians (this build's speed-up). Each binary steps at
+        /// its own default unless --integrator or --dt is given. A shared machine's load then
+        /// falls on both alike.
         #[arg(long, value_name = "BINARY")]
         against: Option<std::path::PathBuf>,
     },
@@ -345,7 +346,7 @@ fn ab_rounds(
     args: &[String],
 ) -> Result<()> {
     println!(
-        "simulation benchmark against {}: {} on {}, {speed_kmh} km/h, {seconds} s, {} step {} ms, {rounds} rounds alternating (µs per step, physics / all channels)",
+        "simulation benchmark against {}: {} on {}, {speed_kmh} km/h, {seconds} s, {} step {} ms, {rounds} rounds alternating (× real time, physics / all channels; each binary at its own default step unless --integrator or --dt is given)",
         other.display(),
         v.name,
         tr.spec().name,
@@ -365,7 +366,7 @@ fn ab_rounds(
         }
         let (a, b) = (this[this.len() - 1], that[that.len() - 1]);
         println!(
-            "  round {}: this {:.2} / {:.2}, the other {:.2} / {:.2}",
+            "  round {}: this {:.1} / {:.1}, the other {:.1} / {:.1}",
             round + 1,
             a.0,
             a.1,
@@ -373,11 +374,11 @@ fn ab_rounds(
             b.1
         );
     }
-    // Physics-only and recorded µs of each side, then the two summaries of each.
+    // Physics-only and recorded real-time factors of each side, then the two summaries of each.
     let column = |v: &[(f64, f64)], k: usize| -> Vec<f64> {
         v.iter().map(|x| if k == 0 { x.0 } else { x.1 }).collect()
     };
-    let fastest = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let fastest = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
     for (name, stat) in [
         ("median", against::median as fn(&[f64]) -> f64),
         ("fastest", fastest),
@@ -385,9 +386,9 @@ fn ab_rounds(
         let [p, q, r, s] =
             [(&this, 0), (&that, 0), (&this, 1), (&that, 1)].map(|(v, k)| stat(&column(v, k)));
         println!(
-            "  {name}: physics {p:.2} against {q:.2} µs ({:.3}× the other's speed), all channels {r:.2} against {s:.2} µs ({:.3}×)",
-            q / p,
-            s / r
+            "  {name}: physics {p:.1}× against {q:.1}× real time ({:.3}× the other's speed), all channels {r:.1}× against {s:.1}× ({:.3}×)",
+            p / q,
+            r / s
         );
     }
     println!("  build: {}", railforce::sim::profile::vector_build());

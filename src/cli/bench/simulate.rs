@@ -67,8 +67,8 @@ fn timed_run(base: &SimConfig, speed: f64, seconds: f64) -> (SimConfig, usize) {
     (cfg, steps)
 }
 
-/// µs per step physics only and with all channels, one measurement of each (the A/B rounds of
-/// `bench simulate --against`).
+/// Real-time factors (simulated over wall seconds) physics only and with all channels, one
+/// measurement of each (the A/B rounds of `bench simulate --against`).
 pub fn once(
     vehicle: &Vehicle,
     track: &Track,
@@ -78,7 +78,8 @@ pub fn once(
 ) -> Result<(f64, f64)> {
     let (cfg, steps) = timed_run(base, speed, seconds);
     let (p, r) = measure(vehicle, track, &cfg, steps)?;
-    Ok((p * 1e6 / steps as f64, r * 1e6 / steps as f64))
+    let simulated = steps as f64 * cfg.dt;
+    Ok((simulated / p, simulated / r))
 }
 
 /// Runs `seconds` of simulated time physics only, then with the recorder, `repeats` times in
