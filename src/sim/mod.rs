@@ -24,6 +24,7 @@ pub mod profile;
 mod request;
 mod track_frame;
 mod wheel_rail;
+mod wheelset_solve;
 
 pub use integrator::{Integrator, Stepping};
 pub use output::{Recorder, RunSummary};

@@ -1,0 +1,364 @@
+//! Each wheelset and its two rail masses solved together in one linearly implicit step: the
+//! contact's damping at the share θ, and with [`super::Integrator::LinearlyImplicitHertz`] its
+//! Hertz spring at the share α and the wheelset's gyroscopic moment at θ (the step's loop is
+//! [`super::integrator`]'s).
+//!
+//! The contact's Hertz spring in the solve (`linearly-implicit-hertz`): explicit, the wheel and
+//! its rail mass on the spring between them (about 2 840 rad/s) limit the step to ω·Δt < 2, and
+//! the statistics fall off a cliff above 0.6 ms (28–38 % off at 5/7 ms, R 400 m at 100 km/h).
+//! Taking `α·Δt²·K` into the solve beside `θ·Δt·D` (`K` the patches' normal stiffness at their
+//! load centres, [`crate::contact::patch_stiffness`]) makes a linear spring's step
+//! `M·Δv = Δt·F(x) − α·Δt²·K·Δv`: symplectic Euler on `ω̃² = ω²/(1 + α·ω²·Δt²)`, with no
+//! numerical damping and a stability limit of ω·Δt < 2/√(1 − 4α). α = 1/12 is Fox and
+//! Goodwin's share (Newmark's β = 1/12, γ = ½), whose frequency is right to fourth order (5 %
+//! high at ω·Δt = 2, limit 2.45); α = 0.1, the default's, puts it right at the default step
+//! with a wider margin (see [`ALPHA`]); α = ¼ (the average acceleration, unconditionally
+//! stable) puts the mode 13 % low at 0.5 ms (tried earlier, without the surface's change
+//! below: Q's standard deviation 1.1 % off at 0.5 ms). The share sees the rail masses'
+//! motion, and it must see the rail surface's: the irregularity passing under the wheel is the
+//! spring's other end, and a share that ignores its change over the step acts on the wheel's
+//! following of it as an extra mass `θ·Δt·c_n + α·Δt²·k_n` (25 + 38 kg per wheel at 0.5 ms
+//! and α = 0.1, against the wheel's 650; measured with α = 1/12, R 400 m at 100 km/h: Q's
+//! standard deviation 0.53 → 0.29 % off at 0.5 ms and 1.07 → 0.62 % at 5/7 ms with the change
+//! seen). The change is taken from the last step (one step behind, an estimate).
+//!
+//! The same integrator takes each wheelset's gyroscopic moment into the solve at θ = ½ (the
+//! spin Ω = V/r₀ couples roll and yaw by `I_y·Ω`). Explicit, that coupling lags half a step,
+//! a first-order error in the hunting threshold: the restrained wheelset's critical speed
+//! (`validate dynamics`, Wickens; closed form 38.33 m/s) was 38.34 / 38.28 / 38.23 / 38.06 /
+//! 37.95 / 37.89 m/s at 0.05 (semi-implicit) / 0.125 / 0.25 / 0.5 / 0.625 / 5/7 ms, the Hertz
+//! share making no difference at 0.5 ms; with the moment in the solve, 38.34 m/s at 0.5 and
+//! 5/7 ms alike (the bisection's resolution is 0.06 m/s).
+
+use super::wheel_rail::{RailCoupling, RailState};
+use nalgebra::{Matrix2, Matrix3, Matrix6, SMatrix, Vector2, Vector6};
+
+/// Share of the contact damping taken at the step's end, on the wheelset and its rails alike
+/// (the trapezoidal rule; see the module's comment).
+pub(super) const THETA: f64 = 0.5;
+
+/// Share of the contact's Hertz spring taken at the step's end with
+/// [`super::Integrator::LinearlyImplicitHertz`]: `α` in `α·Δt²·K` (see the module's comment). The share
+/// that puts the wheel–rail mode's frequency right at the default step is 0.104 (ω·Δt = 2.03 at
+/// 5/7 ms), and 0.097 at 0.625 ms; 0.1 puts it within 1 % at both. Fox and Goodwin's 1/12
+/// (the frequency right to fourth order in ω·Δt) has the smaller stability margin, ω·Δt < 2.45
+/// against 2.58: the Hertz spring stiffens as N^{1/3}, so a load peak of 3.1 times the static
+/// load takes 1/12 past its limit at 5/7 ms and 4.2 times takes 0.1. Measured on paper34's 34
+/// conditions at 5/7 ms (`bench step`, 60 s): with 1/12 four conditions 1.0–1.7 % off in Q's
+/// standard deviation (tangent at 60 km/h 1.2 %), with 0.1 every one within 0.67 %.
+pub(super) const ALPHA: f64 = 0.1;
+
+/// How the linearly implicit solve takes the contact at step `dt`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Shares {
+    /// `θ` of its damping.
+    pub theta: f64,
+    /// `α·Δt` of its normal stiffness (0: the Hertz spring explicit).
+    pub alpha_dt: f64,
+}
+
+/// Mass, support stiffness and support damping of a rail mass, lateral and vertical.
+fn rail_matrices(sup: &crate::track::RailSupport) -> (Matrix2<f64>, Matrix2<f64>, Matrix2<f64>) {
+    (
+        Matrix2::from_diagonal(&Vector2::new(sup.lateral.mass, sup.vertical.mass)),
+        Matrix2::from_diagonal(&Vector2::new(sup.lateral.stiffness, sup.vertical.stiffness)),
+        Matrix2::from_diagonal(&Vector2::new(sup.lateral.damping, sup.vertical.damping)),
+    )
+}
+
+/// A wheelset's inverse mass: its mass and its inverse inertia tensor in world axes.
+pub(super) struct Inverse {
+    pub(super) mass: f64,
+    pub(super) inertia: Matrix3<f64>,
+    /// `θ·Δt·I⁻¹·∂(ω × I·ω)/∂ω`, world axes (zero where the gyroscopic moment stays explicit).
+    pub(super) gyroscopic: Matrix3<f64>,
+}
+
+impl Inverse {
+    /// `M⁻¹` applied to every column of `m`, whose rows are a wrench's (force, moment).
+    pub(super) fn apply<const C: usize>(&self, m: &mut SMatrix<f64, 6, C>) {
+        for col in 0..C {
+            let f = m.fixed_view::<3, 1>(0, col) / self.mass;
+            let t = self.inertia * m.fixed_view::<3, 1>(3, col);
+            m.fixed_view_mut::<3, 1>(0, col).copy_from(&f);
+            m.fixed_view_mut::<3, 1>(3, col).copy_from(&t);
+        }
+    }
+}
+
+/// One linearly implicit step of a wheelset (velocity change `du` explicit, damping `d` in
+/// world axes) and its two rail masses solved together; moves the rails and returns the
+/// wheelset's velocity change. Wheelset rows: `(I + θΔt·M⁻¹·D)·Δu − θΔt·M⁻¹·Σ D_k·P·Δr_k =
+/// Δu_explicit`. Rail rows, implicit in their support and in the damper they share with the
+/// wheel (θ on both sides, so the damper's impulses are equal and opposite):
+/// `(M_r + Δt·(θ·C_c + C_s) + Δt²·K_s)·Δr_k − θΔt·Pᵀ·D_k·Δu = Δt·(R_k − K_s·(x + Δt·v) − C_s·v)`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn with_rails(
+    body: &Inverse,
+    d: &Matrix6<f64>,
+    du: Vector6<f64>,
+    dt: f64,
+    rails: &mut [RailState],
+    coupling: &[RailCoupling],
+    rail_force: &[[f64; 2]],
+    surface: &[Vector2<f64>; 2],
+    sup: &crate::track::RailSupport,
+) -> Vector6<f64> {
+    let (m, ks, cs) = rail_matrices(sup);
+    let mut a = d * (THETA * dt);
+    body.apply(&mut a);
+    let mut g = a.fixed_view_mut::<3, 3>(3, 3);
+    g += body.gyroscopic;
+    // The rails' rows eliminated (a Schur complement: each rail's block is 2×2), so the
+    // solve is the wheelset's 6×6: Δr_k = L_k⁻¹·(r_k − Y_k·Δu),
+    // (I + A − Σ X_k·L_k⁻¹·Y_k)·Δu = Δu_explicit − Σ X_k·L_k⁻¹·r_k.
+    let mut lhs6 = Matrix6::identity() + a;
+    let mut rhs6 = du;
+    let mut parts = [(
+        Matrix2::zeros(),
+        SMatrix::<f64, 2, 6>::zeros(),
+        Vector2::zeros(),
+    ); 2];
+    for side in 0..2 {
+        let (rail, c, f) = (&rails[side], &coupling[side], rail_force[side]);
+        let mut x = -c.from_rail * (THETA * dt);
+        body.apply(&mut x);
+        let y = -c.to_rail * (THETA * dt);
+        let (xv, vv) = (Vector2::new(rail.y, rail.z), Vector2::new(rail.vy, rail.vz));
+        let l = m + (c.damping * THETA + cs) * dt + ks * (dt * dt);
+        let mut r = (Vector2::from(f) - ks * (xv + vv * dt) - cs * vv) * dt;
+        if surface[side] != Vector2::zeros() {
+            r -= c.surface_on_rail * surface[side];
+        }
+        let l_inv = l.try_inverse().unwrap_or_else(Matrix2::zeros);
+        lhs6 -= x * (l_inv * y);
+        rhs6 -= x * (l_inv * r);
+        parts[side] = (l_inv, y, r);
+    }
+    let du = lhs6.lu().solve(&rhs6).unwrap_or(rhs6);
+    for (rail, (l_inv, y, r)) in rails.iter_mut().zip(parts) {
+        let dv = l_inv * (r - y * du);
+        rail.vy += dv.x;
+        rail.vz += dv.y;
+        rail.y += rail.vy * dt;
+        rail.z += rail.vz * dt;
+    }
+    du
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::track::{RailSupport, Support};
+    use nalgebra::Vector3;
+
+    /// A damper at point `p` (wheelset axes = track axes here rotated by `a`), damping `c`
+    /// along track x, y, z: `D = [C, −C·[p]×; [p]×·C, −[p]×·C·[p]×]` in track axes.
+    fn point_damper(p: Vector3<f64>, c: Vector3<f64>) -> Matrix6<f64> {
+        let (c, px) = (Matrix3::from_diagonal(&c), p.cross_matrix());
+        let mut d = Matrix6::zeros();
+        d.fixed_view_mut::<3, 3>(0, 0).copy_from(&c);
+        d.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-c * px));
+        d.fixed_view_mut::<3, 3>(3, 0).copy_from(&(px * c));
+        d.fixed_view_mut::<3, 3>(3, 3).copy_from(&(-(px * c * px)));
+        d
+    }
+
+    /// The damper a wheel shares with its rail moves momentum between them and creates none:
+    /// with no other force (rails free, no support), a wheelset sliding sideways over its
+    /// rails on a canted, turned track gives them exactly the lateral and vertical momentum it
+    /// loses at every step, the energy never rises, and it settles near a perfectly
+    /// inelastic collision's.
+    #[test]
+    fn the_shared_damper_conserves_momentum_and_dissipates() {
+        let a = (nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), 0.3)
+            * nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), 0.1))
+        .into_inner();
+        let free = Support {
+            mass: 250.0,
+            stiffness: 0.0,
+            damping: 0.0,
+        };
+        let sup = RailSupport {
+            lateral: free,
+            vertical: free,
+        };
+        let (mass, dt) = (1200.0, 5e-4);
+        let body = Inverse {
+            mass,
+            inertia: Matrix3::from_diagonal(&Vector3::new(700.0, 100.0, 700.0).map(|x| 1.0 / x)),
+            gyroscopic: Matrix3::zeros(),
+        };
+        let dampers = [
+            point_damper(Vector3::new(0.0, 0.75, -0.42), Vector3::new(4e5, 3e5, 2e5)),
+            point_damper(Vector3::new(0.0, -0.75, -0.42), Vector3::new(4e5, 5e5, 2e5)),
+        ];
+        let coupling = dampers.map(|d| RailCoupling::new(&d, &a));
+        let mut d = Matrix6::zeros();
+        for dk in &dampers {
+            let mut w = Matrix6::zeros();
+            for (r, c) in [(0, 0), (0, 3), (3, 0), (3, 3)] {
+                let blk = dk.fixed_view::<3, 3>(r, c).into_owned();
+                w.fixed_view_mut::<3, 3>(r, c)
+                    .copy_from(&(a * blk * a.transpose()));
+            }
+            d += w;
+        }
+        // The wheelset slides 0.1 m/s sideways (track y) and sinks 0.01 m/s; rails at rest.
+        let v0 = a * Vector3::new(0.0, 0.1, -0.01);
+        let mut u = Vector6::new(v0.x, v0.y, v0.z, 0.0, 0.0, 0.0);
+        let mut rails = [RailState::default(); 2];
+        let inertia = Matrix3::from_diagonal(&Vector3::new(700.0, 100.0, 700.0));
+        let energy = |u: &Vector6<f64>, rails: &[RailState; 2]| {
+            let (v, w) = (u.fixed_rows::<3>(0), u.fixed_rows::<3>(3));
+            0.5 * mass * v.norm_squared()
+                + 0.5 * w.dot(&(inertia * w))
+                + rails
+                    .iter()
+                    .map(|r| 0.5 * 250.0 * (r.vy * r.vy + r.vz * r.vz))
+                    .sum::<f64>()
+        };
+        let e0 = energy(&u, &rails);
+        let mut e = e0;
+        for _ in 0..20 {
+            // The law's forces at the step's start: the same damper, linear.
+            let r = |k: usize| Vector2::new(rails[k].vy, rails[k].vz);
+            let mut du_exp =
+                (-d * u + coupling[0].from_rail * r(0) + coupling[1].from_rail * r(1)) * dt;
+            body.apply(&mut du_exp);
+            let force = [0, 1].map(|k| {
+                let f = coupling[k].to_rail * u - coupling[k].damping * r(k);
+                [f.x, f.y]
+            });
+            let before = rails;
+            let du = with_rails(
+                &body,
+                &d,
+                du_exp,
+                dt,
+                &mut rails,
+                &coupling,
+                &force,
+                &[Vector2::zeros(); 2],
+                &sup,
+            );
+            // Wheelset's momentum change along track y and z against the rails'.
+            let dp = a.transpose() * (du.fixed_rows::<3>(0) * mass);
+            let rails_dp: f64 = (0..2).map(|k| (rails[k].vy - before[k].vy) * 250.0).sum();
+            let rails_dz: f64 = (0..2).map(|k| (rails[k].vz - before[k].vz) * 250.0).sum();
+            assert!(
+                (dp.y + rails_dp).abs() < 1e-9 * dp.y.abs().max(1.0),
+                "{dp} {rails_dp}"
+            );
+            assert!(
+                (dp.z + rails_dz).abs() < 1e-9 * dp.z.abs().max(1.0),
+                "{dp} {rails_dz}"
+            );
+            u += du;
+            // A damper only dissipates.
+            let now = energy(&u, &rails);
+            assert!(now <= e * (1.0 + 1e-12), "energy rose: {e} → {now}");
+            e = now;
+        }
+        // The rails were dragged along the slide, and the sliding's energy went: within 10 ms
+        // close to a perfectly inelastic collision's, never below it (the least energy the
+        // conserved momentum allows: m_w/(m_w + 2·m_r) of the start's).
+        assert!(rails.iter().all(|r| r.vy > 0.01), "{rails:?}");
+        let least = e0 * mass / (mass + 500.0);
+        assert!(
+            e >= least && e < 1.05 * least,
+            "{e0} → {e}, at least {least}"
+        );
+    }
+
+    /// The contact's Hertz spring in the solve against the closed form (issue 37's stiff
+    /// spring–mass at the new step): a wheelset on two free rail masses (250 kg each) on
+    /// vertical springs of 1.5 GN/m at its wheels, their relative mode at ω = 2 880 rad/s, so
+    /// ω·Δt = 2.06 at 5/7 ms, past the explicit step's limit of 2. With the share α the step is
+    /// symplectic Euler on `Ω² = ω²/(1 + α·ω²·Δt²)`: its period is `2π·Δt / (2·asin(Ω·Δt/2))`
+    /// (within 0.5 %; measured 4·10⁻⁶ off), its amplitude neither grows nor decays (the largest swing of
+    /// the last cycles within 2 % of the first's), the momentum stays; explicit (α = 0) it grows
+    /// without bound.
+    #[test]
+    fn the_hertz_share_keeps_the_stiff_mode_at_its_closed_form() {
+        let free = Support {
+            mass: 250.0,
+            stiffness: 0.0,
+            damping: 0.0,
+        };
+        let sup = RailSupport {
+            lateral: free,
+            vertical: free,
+        };
+        let (mass, k, dt) = (1300.0, 1.5e9, 5e-3 / 7.0);
+        let body = Inverse {
+            mass,
+            inertia: Matrix3::from_diagonal(&Vector3::new(700.0, 100.0, 700.0).map(|x| 1.0 / x)),
+            gyroscopic: Matrix3::zeros(),
+        };
+        let springs = [0.75, -0.75]
+            .map(|y| point_damper(Vector3::new(0.0, y, -0.45), Vector3::new(0.0, 0.0, k)));
+        let omega = (2.0 * k * (1.0 / mass + 1.0 / 500.0)).sqrt();
+        let run = |alpha: f64| {
+            let d_eff = springs.map(|s| s * (alpha * dt / THETA));
+            let coupling = d_eff.map(|d| RailCoupling::new(&d, &Matrix3::identity()));
+            let d: Matrix6<f64> = d_eff.iter().sum();
+            let (mut u, mut x) = (Vector6::zeros(), Vector6::zeros());
+            // The wheelset 10 µm into its rails, everything at rest.
+            x[2] = -1e-5;
+            let mut rails = [RailState::default(); 2];
+            let mut rel = Vec::new();
+            for _ in 0..3000 {
+                let r = |k: usize| Vector6::new(0.0, rails[k].y, rails[k].z, 0.0, 0.0, 0.0);
+                let f = [0, 1].map(|j| -(springs[j] * (x - r(j))));
+                let mut du_exp = (f[0] + f[1]) * dt;
+                body.apply(&mut du_exp);
+                let force = f.map(|f| [-f[1], -f[2]]);
+                let du = with_rails(
+                    &body,
+                    &d,
+                    du_exp,
+                    dt,
+                    &mut rails,
+                    &coupling,
+                    &force,
+                    &[Vector2::zeros(); 2],
+                    &sup,
+                );
+                u += du;
+                x += u * dt;
+                rel.push(x[2] - 0.5 * (rails[0].z + rails[1].z));
+                if rel[rel.len() - 1].abs() > 1e-3 {
+                    break; // a hundred times the start: diverging
+                }
+                let momentum = mass * u[2] + 250.0 * (rails[0].vz + rails[1].vz);
+                let scale = mass * u[2].abs() + 250.0 * (rails[0].vz.abs() + rails[1].vz.abs());
+                assert!(momentum.abs() <= 1e-12 * scale.max(1.0), "{momentum}");
+            }
+            rel
+        };
+        let rel = run(ALPHA);
+        assert_eq!(rel.len(), 3000);
+        let up: Vec<f64> = (1..rel.len())
+            .filter(|&i| rel[i - 1] < 0.0 && rel[i] >= 0.0)
+            .map(|i| (i as f64 - rel[i] / (rel[i] - rel[i - 1])) * dt)
+            .collect();
+        let period = (up[up.len() - 1] - up[0]) / (up.len() - 1) as f64;
+        let big = omega / (1.0 + ALPHA * (omega * dt).powi(2)).sqrt();
+        let closed = std::f64::consts::TAU * dt / (2.0 * (big * dt / 2.0).asin());
+        assert!(
+            (period / closed - 1.0).abs() < 0.005,
+            "period {period:e} s against {closed:e} s (ω·Δt {:.3})",
+            omega * dt
+        );
+        let swing = |r: &[f64]| r.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let (first, last) = (swing(&rel[..300]), swing(&rel[rel.len() - 300..]));
+        assert!((last / first - 1.0).abs() < 0.02, "{first:e} → {last:e}");
+        let explicit = run(0.0);
+        assert!(
+            swing(&explicit) > 50.0 * first,
+            "the explicit step at ω·Δt {:.2} should not hold",
+            omega * dt
+        );
+    }
+}
