@@ -152,6 +152,29 @@ mod tests {
     use crate::track::{RailSupport, Support};
     use nalgebra::Vector3;
 
+    /// [`with_rails`] on rail masses of 250 kg with no support and no surface change.
+    fn on_free_rails(
+        body: &Inverse,
+        d: &Matrix6<f64>,
+        du: Vector6<f64>,
+        dt: f64,
+        rails: &mut [RailState; 2],
+        coupling: &[RailCoupling; 2],
+        force: &[[f64; 2]; 2],
+    ) -> Vector6<f64> {
+        let free = Support {
+            mass: 250.0,
+            stiffness: 0.0,
+            damping: 0.0,
+        };
+        let sup = RailSupport {
+            lateral: free,
+            vertical: free,
+        };
+        let surface = [Vector2::zeros(); 2];
+        with_rails(body, d, du, dt, rails, coupling, force, &surface, &sup)
+    }
+
     /// A damper at point `p` (wheelset axes = track axes here rotated by `a`), damping `c`
     /// along track x, y, z: `D = [C, −C·[p]×; [p]×·C, −[p]×·C·[p]×]` in track axes.
     fn point_damper(p: Vector3<f64>, c: Vector3<f64>) -> Matrix6<f64> {
@@ -174,15 +197,6 @@ mod tests {
         let a = (nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), 0.3)
             * nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), 0.1))
         .into_inner();
-        let free = Support {
-            mass: 250.0,
-            stiffness: 0.0,
-            damping: 0.0,
-        };
-        let sup = RailSupport {
-            lateral: free,
-            vertical: free,
-        };
         let (mass, dt) = (1200.0, 5e-4);
         let body = Inverse {
             mass,
@@ -231,17 +245,7 @@ mod tests {
                 [f.x, f.y]
             });
             let before = rails;
-            let du = with_rails(
-                &body,
-                &d,
-                du_exp,
-                dt,
-                &mut rails,
-                &coupling,
-                &force,
-                &[Vector2::zeros(); 2],
-                &sup,
-            );
+            let du = on_free_rails(&body, &d, du_exp, dt, &mut rails, &coupling, &force);
             // Wheelset's momentum change along track y and z against the rails'.
             let dp = a.transpose() * (du.fixed_rows::<3>(0) * mass);
             let rails_dp: f64 = (0..2).map(|k| (rails[k].vy - before[k].vy) * 250.0).sum();
@@ -281,15 +285,6 @@ mod tests {
     /// without bound.
     #[test]
     fn the_hertz_share_keeps_the_stiff_mode_at_its_closed_form() {
-        let free = Support {
-            mass: 250.0,
-            stiffness: 0.0,
-            damping: 0.0,
-        };
-        let sup = RailSupport {
-            lateral: free,
-            vertical: free,
-        };
         let (mass, k, dt) = (1300.0, 1.5e9, 5e-3 / 7.0);
         let body = Inverse {
             mass,
@@ -314,17 +309,7 @@ mod tests {
                 let mut du_exp = (f[0] + f[1]) * dt;
                 body.apply(&mut du_exp);
                 let force = f.map(|f| [-f[1], -f[2]]);
-                let du = with_rails(
-                    &body,
-                    &d,
-                    du_exp,
-                    dt,
-                    &mut rails,
-                    &coupling,
-                    &force,
-                    &[Vector2::zeros(); 2],
-                    &sup,
-                );
+                let du = on_free_rails(&body, &d, du_exp, dt, &mut rails, &coupling, &force);
                 u += du;
                 x += u * dt;
                 rel.push(x[2] - 0.5 * (rails[0].z + rails[1].z));
