@@ -30,8 +30,9 @@ pub use integrator::{Integrator, Stepping};
 pub use output::{Recorder, RunSummary};
 pub use request::RunRequest;
 pub use track_frame::{TrackFrame, project};
-use wheel_rail::RailCoupling;
-pub use wheel_rail::{RailState, WheelResult};
+pub use wheel_rail::WheelResult;
+pub use wheelset_solve::RailState;
+use wheelset_solve::{RailCoupling, Shares};
 
 use crate::error::{Error, Result};
 use crate::track::Track;
@@ -158,6 +159,8 @@ pub struct Simulation<'a> {
     /// Per wheel: the contact's damping and normal stiffness on the rail's lateral and
     /// vertical motion, track axes (the linearly implicit step's).
     rail_coupling: Vec<RailCoupling>,
+    /// How the implicit solve takes the contact (none for the explicit integrators).
+    shares: Option<Shares>,
     /// Per wheel: the rail surface's rate under it at the last step, track `(ẏ, ż)` (the
     /// linearly implicit step's; none before the first).
     surface_rates: Vec<Option<nalgebra::Vector2<f64>>>,
@@ -309,6 +312,7 @@ impl<'a> Simulation<'a> {
             contact_damping: vec![nalgebra::Matrix6::zeros(); vehicle.contact.wheelsets.len()],
             rail_coupling: vec![RailCoupling::default(); n_wheels],
             surface_rates: vec![None; n_wheels],
+            shares: cfg.integrator.shares(cfg.dt),
             inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
             hauling_integral: 0.0,

@@ -4,6 +4,7 @@
 //! and its reaction on the rail masses.
 
 use super::Simulation;
+use super::wheelset_solve::{RailCoupling, Shares};
 use crate::contact::{Creepage, Side, WheelOnRail, evaluate};
 use crate::error::Result;
 use nalgebra::{Matrix6, Vector3};
@@ -37,87 +38,6 @@ pub struct WheelResult {
     pub y_centre: f64,
     /// Slope of this wheel's rail alignment (irregularity), rad.
     pub rail_slope: f64,
-}
-
-/// The rail under one wheel when the track is compliant: lateral and vertical displacement
-/// from its place (irregularity included) and their rates, track axes.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct RailState {
-    /// Lateral displacement, m (+ left).
-    pub y: f64,
-    /// Lateral velocity, m/s.
-    pub vy: f64,
-    /// Vertical displacement, m (+ up).
-    pub z: f64,
-    /// Vertical velocity, m/s.
-    pub vz: f64,
-}
-
-/// The contact between one wheel and its rail mass, linearised for the linearly implicit step:
-/// its damping and stiffness share on the rail's lateral and vertical motion (track axes) and
-/// across to the wheelset's, and how the rail surface's own rise under the rolling wheel (the
-/// irregularity's rate) pushes both through the contact's normal law.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(super) struct RailCoupling {
-    /// On the rail's own motion (`Pᵀ·D_k·P`), track axes.
-    pub damping: nalgebra::Matrix2<f64>,
-    /// How the wheelset's velocity change (world `Δv, Δω`) pushes the rail through this
-    /// wheel's damping: rows `y, z` (track) of `D_k` (`Pᵀ·D_k`).
-    pub to_rail: nalgebra::SMatrix<f64, 2, 6>,
-    /// How the rail's velocity change (track `Δy, Δz`) pushes the wheelset through it
-    /// (`D_k·P`, world wrench).
-    pub from_rail: nalgebra::SMatrix<f64, 6, 2>,
-    /// How a change of the rail surface's rate under the wheel (track `Δẏ, Δż` of the
-    /// irregularity) pushes the wheelset through the normal law's share in the step
-    /// (`G_k·P`, world wrench per m/s, with `G_k = θ·c_n + α·Δt·k_n` along the normal).
-    pub from_surface: nalgebra::SMatrix<f64, 6, 2>,
-    /// The same on the rail (`Pᵀ·G_k·P`, track axes), with the opposite sign.
-    pub surface_on_rail: nalgebra::Matrix2<f64>,
-}
-
-impl RailCoupling {
-    /// The coupling of one wheel's damping `d` (track axes, about the wheelset's centre, as
-    /// [`crate::contact::patch_damping`] sums it) with its rail, the track's axes `a` (track
-    /// to world). The rail's velocity enters the wheel's relative velocity as minus a
-    /// wheelset translation along track y and z (`wheels_on_rails`), so
-    /// `P = [A·e_y, A·e_z; 0, 0]` maps it to the wheelset's world coordinates.
-    pub(super) fn new(d: &nalgebra::Matrix6<f64>, a: &nalgebra::Matrix3<f64>) -> Self {
-        let mut c = RailCoupling {
-            damping: d.fixed_view::<2, 2>(1, 1).into_owned(),
-            ..RailCoupling::default()
-        };
-        for j in 0..2 {
-            let col = d.column(1 + j).into_owned();
-            c.from_rail.set_column(j, &to_world(&col, a));
-            let row = d.row(1 + j);
-            let lin = row.fixed_columns::<3>(0) * a.transpose();
-            let ang = row.fixed_columns::<3>(3) * a.transpose();
-            c.to_rail.fixed_view_mut::<1, 3>(j, 0).copy_from(&lin);
-            c.to_rail.fixed_view_mut::<1, 3>(j, 3).copy_from(&ang);
-        }
-        c
-    }
-
-    /// Sets how the rail surface's rate pushes through the normal law's share: `g` is
-    /// `G_k·P` in track axes (`Σ g_p·J_p·[n_y, n_z]` over the patches, `J_p` from
-    /// [`crate::contact::patch_normal`]), `a` the track's axes.
-    pub(super) fn set_surface(
-        &mut self,
-        g: &nalgebra::SMatrix<f64, 6, 2>,
-        a: &nalgebra::Matrix3<f64>,
-    ) {
-        for j in 0..2 {
-            self.from_surface
-                .set_column(j, &to_world(&g.column(j).into_owned(), a));
-        }
-        self.surface_on_rail = g.fixed_view::<2, 2>(1, 0).into_owned();
-    }
-}
-
-/// A wrench in track axes `(F, M)` in world axes.
-fn to_world(w: &nalgebra::Vector6<f64>, a: &nalgebra::Matrix3<f64>) -> nalgebra::Vector6<f64> {
-    let (f, m) = (a * w.fixed_rows::<3>(0), a * w.fixed_rows::<3>(3));
-    nalgebra::Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
 }
 
 impl Simulation<'_> {
@@ -176,7 +96,7 @@ impl Simulation<'_> {
         let v = self.vehicle;
         let cs = &v.contact;
         let model = cs.model();
-        let shares = self.cfg.integrator.shares(self.cfg.dt);
+        let shares = self.shares;
         for (w, &b) in cs.wheelsets.iter().enumerate() {
             let f = self.frames[b];
             let (inputs, y_centre) = self.wheels_on_rails(w);
@@ -189,7 +109,7 @@ impl Simulation<'_> {
                     evaluate(self.table, &model, &wr)
                 );
                 self.inputs[idx] = wr;
-                if let Some(super::integrator::Shares { theta, alpha_dt }) = shares {
+                if let Some(Shares { theta, alpha_dt }) = shares {
                     // The step's share of the contact: θ·Δt·D + α·Δt²·K, written as one damping
                     // D + (α·Δt/θ)·K; and the normal law's share G = θ·c_n + α·Δt·k_n on the
                     // rail surface's rate (rank one per patch: g·J·Jᵀ, of which the columns of
@@ -267,7 +187,7 @@ impl Simulation<'_> {
             return;
         };
         let dt = self.cfg.dt;
-        if self.cfg.integrator.implicit() {
+        if self.shares.is_some() {
             return;
         }
         for (r, f) in self.rails.iter_mut().zip(&self.rail_force) {

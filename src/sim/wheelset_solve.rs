@@ -30,8 +30,88 @@
 //! share making no difference at 0.5 ms; with the moment in the solve, 38.34 m/s at 0.5 and
 //! 5/7 ms alike (the bisection's resolution is 0.06 m/s).
 
-use super::wheel_rail::{RailCoupling, RailState};
 use nalgebra::{Matrix2, Matrix3, Matrix6, SMatrix, Vector2, Vector6};
+
+/// The rail under one wheel when the track is compliant: lateral and vertical displacement
+/// from its place (irregularity included) and their rates, track axes.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RailState {
+    /// Lateral displacement, m (+ left).
+    pub y: f64,
+    /// Lateral velocity, m/s.
+    pub vy: f64,
+    /// Vertical displacement, m (+ up).
+    pub z: f64,
+    /// Vertical velocity, m/s.
+    pub vz: f64,
+}
+
+/// The contact between one wheel and its rail mass, linearised for the linearly implicit step:
+/// its damping and stiffness share on the rail's lateral and vertical motion (track axes) and
+/// across to the wheelset's, and how the rail surface's own rise under the rolling wheel (the
+/// irregularity's rate) pushes both through the contact's normal law.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct RailCoupling {
+    /// On the rail's own motion (`Pᵀ·D_k·P`), track axes.
+    pub damping: nalgebra::Matrix2<f64>,
+    /// How the wheelset's velocity change (world `Δv, Δω`) pushes the rail through this
+    /// wheel's damping: rows `y, z` (track) of `D_k` (`Pᵀ·D_k`).
+    pub to_rail: nalgebra::SMatrix<f64, 2, 6>,
+    /// How the rail's velocity change (track `Δy, Δz`) pushes the wheelset through it
+    /// (`D_k·P`, world wrench).
+    pub from_rail: nalgebra::SMatrix<f64, 6, 2>,
+    /// How a change of the rail surface's rate under the wheel (track `Δẏ, Δż` of the
+    /// irregularity) pushes the wheelset through the normal law's share in the step
+    /// (`G_k·P`, world wrench per m/s, with `G_k = θ·c_n + α·Δt·k_n` along the normal).
+    pub from_surface: nalgebra::SMatrix<f64, 6, 2>,
+    /// The same on the rail (`Pᵀ·G_k·P`, track axes), with the opposite sign.
+    pub surface_on_rail: nalgebra::Matrix2<f64>,
+}
+
+impl RailCoupling {
+    /// The coupling of one wheel's damping `d` (track axes, about the wheelset's centre, as
+    /// [`crate::contact::patch_damping`] sums it) with its rail, the track's axes `a` (track
+    /// to world). The rail's velocity enters the wheel's relative velocity as minus a
+    /// wheelset translation along track y and z (`wheels_on_rails`), so
+    /// `P = [A·e_y, A·e_z; 0, 0]` maps it to the wheelset's world coordinates.
+    pub(super) fn new(d: &nalgebra::Matrix6<f64>, a: &nalgebra::Matrix3<f64>) -> Self {
+        let mut c = RailCoupling {
+            damping: d.fixed_view::<2, 2>(1, 1).into_owned(),
+            ..RailCoupling::default()
+        };
+        for j in 0..2 {
+            let col = d.column(1 + j).into_owned();
+            c.from_rail.set_column(j, &to_world(&col, a));
+            let row = d.row(1 + j);
+            let lin = row.fixed_columns::<3>(0) * a.transpose();
+            let ang = row.fixed_columns::<3>(3) * a.transpose();
+            c.to_rail.fixed_view_mut::<1, 3>(j, 0).copy_from(&lin);
+            c.to_rail.fixed_view_mut::<1, 3>(j, 3).copy_from(&ang);
+        }
+        c
+    }
+
+    /// Sets how the rail surface's rate pushes through the normal law's share: `g` is
+    /// `G_k·P` in track axes (`Σ g_p·J_p·[n_y, n_z]` over the patches, `J_p` from
+    /// [`crate::contact::patch_normal`]), `a` the track's axes.
+    pub(super) fn set_surface(
+        &mut self,
+        g: &nalgebra::SMatrix<f64, 6, 2>,
+        a: &nalgebra::Matrix3<f64>,
+    ) {
+        for j in 0..2 {
+            self.from_surface
+                .set_column(j, &to_world(&g.column(j).into_owned(), a));
+        }
+        self.surface_on_rail = g.fixed_view::<2, 2>(1, 0).into_owned();
+    }
+}
+
+/// A wrench in track axes `(F, M)` in world axes.
+fn to_world(w: &nalgebra::Vector6<f64>, a: &nalgebra::Matrix3<f64>) -> nalgebra::Vector6<f64> {
+    let (f, m) = (a * w.fixed_rows::<3>(0), a * w.fixed_rows::<3>(3));
+    nalgebra::Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
+}
 
 /// Share of the contact damping taken at the step's end, on the wheelset and its rails alike
 /// (the trapezoidal rule; see the module's comment).
