@@ -78,8 +78,9 @@ def simulate(
     first), or a pandas DataFrame with ``as_frame=True``. ``channels`` keeps only those (and
     ``time_s``); ``seed`` overrides the track file's irregularity seed. A derailment stops
     the run with ``ValueError`` unless ``keep_going``. ``integrator`` (default
-    ``"linearly-implicit"``; ``"semi-implicit"``, ``"heun"``) and ``dt`` (default the
-    integrator's own step: 0.5 ms, or 0.2 ms for the other two) as the command line takes them.
+    ``"linearly-implicit-hertz"``; ``"linearly-implicit"``, ``"semi-implicit"``, ``"heun"``) and
+    ``dt`` (default the integrator's own step: 5/7 ms, 0.5 ms, or 0.2 ms for the last two) as
+    the command line takes them.
     """
     cols = _native.simulate(
         os.fspath(track),
