@@ -109,8 +109,10 @@ fn generate_resume_shard_merge_and_formats() {
     assert_eq!(std::fs::read(&file).unwrap(), bytes);
     assert_eq!(dataset::data_identity(&a).unwrap(), identity);
 
-    // Another integrator is another data set: nothing resumes, the manifest says which, and
-    // the forces differ; a step outside (0, 1 ms] is refused before any run.
+    // Another integrator is another data set: a folder made at one is refused at another,
+    // naming both (the default's step has changed, so a run's key alone cannot tell);
+    // elsewhere it runs everything, the manifest says which, and the forces differ; a step
+    // outside (0, 1 ms] is refused before any run.
     let li = dir.join("li");
     let stepping = railforce::sim::Stepping {
         integrator: railforce::sim::Integrator::SemiImplicit,
@@ -124,6 +126,14 @@ fn generate_resume_shard_merge_and_formats() {
         stepping,
         ..opts(&li, Format::Npz, None)
     };
+    let e = dataset::generate(&plan, &o, &|_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("integration at 0.714") && e.contains("now 0.2 ms, semi-implicit"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&li).unwrap();
     let (m_li, ev) = run_events(&plan, &o);
     assert_eq!(started(&ev), 3, "another integrator resumes nothing");
     assert_eq!(m_li["integration"]["dt_s"], 2e-4);

@@ -41,6 +41,40 @@ pub struct Integration {
     pub anti_alias: String,
 }
 
+impl Integration {
+    /// How `generate` with `opts` integrates every run, as its manifest says it.
+    pub(super) fn of(opts: &GenerateOptions) -> Self {
+        use crate::sim::Integrator;
+        Integration {
+            integrator: match opts.stepping.integrator {
+                Integrator::SemiImplicit => "semi-implicit Euler, fixed step (src/sim/mod.rs)".into(),
+                Integrator::LinearlyImplicit => {
+                    "linearly implicit: semi-implicit Euler with each wheelset and its two rail masses \
+                     solved together in the wheel–rail damping at the step's midpoint, the rails' \
+                     support implicit, fixed step (src/sim/integrator.rs)"
+                        .into()
+                }
+                Integrator::LinearlyImplicitHertz => {
+                    "linearly implicit with the contact's Hertz spring: as linearly implicit, and \
+                     the contact's normal stiffness at the share 0.1 of dt^2 K seeing the rail \
+                     surface's passing, and each wheelset's gyroscopic moment at the step's \
+                     midpoint, fixed step (src/sim/wheelset_solve.rs)"
+                        .into()
+                }
+                Integrator::Heun => "Heun's method (explicit trapezoidal, second order), fixed step \
+                     (src/sim/integrator.rs)"
+                    .into(),
+            },
+            dt_s: opts.stepping.dt,
+            settle_s: opts.settle,
+            anti_alias: format!(
+                "8th-order Butterworth low-pass at {} Hz at the integration rate, then decimated",
+                crate::sim::SimConfig::default().cutoff
+            ),
+        }
+    }
+}
+
 /// The label channels and their wheel.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Labels {
@@ -385,6 +419,22 @@ pub(super) fn refuse_mixing(
             json(&m.dataset),
             json(dataset)
         ));
+    }
+    // A run's key names its stepping only when it is not the default, and the default has
+    // changed (0.5 ms linearly implicit until 2026-12-04 evening): the manifest says how its
+    // runs were integrated, so a data set never resumes at another step or integrator.
+    if let Some(had) = &m.integration {
+        let now = Integration::of(opts);
+        if had.integrator != now.integrator || had.dt_s != now.dt_s {
+            let ms = |dt: f64| (dt * 1e7).round() / 1e4;
+            differ.push(format!(
+                "integration at {} ms, {} (now {} ms, {}; `--integrator`, `--dt`)",
+                ms(had.dt_s),
+                had.integrator.split(':').next().unwrap_or_default(),
+                ms(now.dt_s),
+                now.integrator.split(':').next().unwrap_or_default()
+            ));
+        }
     }
     if differ.is_empty() {
         return Ok(());

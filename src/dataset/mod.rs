@@ -279,36 +279,7 @@ pub fn generate(
     for (_, v, _) in &vehicles {
         v.contact.table(); // build once, before the threads
     }
-    let integration = Integration {
-        integrator: match opts.stepping.integrator {
-            crate::sim::Integrator::SemiImplicit => {
-                "semi-implicit Euler, fixed step (src/sim/mod.rs)".into()
-            }
-            crate::sim::Integrator::LinearlyImplicit => {
-                "linearly implicit: semi-implicit Euler with each wheelset and its two rail masses \
-                 solved together in the wheel–rail damping at the step's midpoint, the rails' \
-                 support implicit, fixed step (src/sim/integrator.rs)"
-                    .into()
-            }
-            crate::sim::Integrator::LinearlyImplicitHertz => {
-                "linearly implicit with the contact's Hertz spring: as linearly implicit, and the \
-                 contact's normal stiffness at the share 0.1 of dt^2 K with the \
-                 rail surface's passing, fixed step (src/sim/integrator.rs)"
-                    .into()
-            }
-            crate::sim::Integrator::Heun => {
-                "Heun's method (explicit trapezoidal, second order), fixed step \
-                 (src/sim/integrator.rs)"
-                    .into()
-            }
-        },
-        dt_s: opts.stepping.dt,
-        settle_s: opts.settle,
-        anti_alias: format!(
-            "8th-order Butterworth low-pass at {} Hz at the integration rate, then decimated",
-            SimConfig::default().cutoff
-        ),
-    };
+    let integration = Integration::of(opts);
     let manifest = Mutex::new(Manifest {
         tool: format!("railforce {}", env!("CARGO_PKG_VERSION")),
         plan: plan.source.clone(),
