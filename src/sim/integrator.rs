@@ -162,11 +162,9 @@ impl Simulation<'_> {
             (&mut self.rails, &self.rail_coupling, &self.rail_force);
         let (inputs, last_rates) = (&self.inputs, &mut self.surface_rates);
         let implicit = self.cfg.integrator.implicit();
-        let follow_surface = self
-            .cfg
-            .integrator
-            .shares(dt)
-            .is_some_and(|s| s.alpha_dt > 0.0);
+        // The Hertz integrator's additions: the rail surface's passing and the gyroscopic
+        // moment in the solve.
+        let hertz = self.cfg.integrator == Integrator::LinearlyImplicitHertz;
         for (i, (st, w)) in self.states.iter_mut().zip(&self.wrenches).enumerate() {
             let b = &self.vehicle.bodies[i];
             let (acc, wb, dwb) = body_rates(b, st, w);
@@ -201,7 +199,7 @@ impl Simulation<'_> {
                 dw_explicit.z,
             );
             let k = wheelset.expect("a damped body is a wheelset");
-            let gyroscopic = if follow_surface {
+            let gyroscopic = if hertz {
                 // The gyroscopic moment in the solve at θ (its slope in ω:
                 // ∂(ω × I·ω)/∂ω = [ω]×·I − [I·ω]×): explicit, the spin's coupling of roll and
                 // yaw lags half a step, a first-order error in the hunting threshold (module
@@ -224,7 +222,7 @@ impl Simulation<'_> {
             // change is the last step's, an estimate one step behind.
             let pair = 2 * k..2 * k + 2;
             let mut surface = [Vector2::zeros(); 2];
-            let du = if follow_surface {
+            let du = if hertz {
                 let mut push = SMatrix::<f64, 6, 1>::zeros();
                 for (side, idx) in pair.clone().enumerate() {
                     let now = Vector2::from(inputs[idx].surface_rate);
