@@ -70,10 +70,10 @@ pub fn patch_damping_with_spring(
 /// contact angle's cosine) along its normal, at its load centre. The contact's Hertz spring,
 /// for the linearly implicit step's stiffness share; the change of the contact angle and of the
 /// creep forces with the displacement (gravitational stiffness, hundreds of times softer) is
-/// left out.
+/// left out. Rank one: `k_n·J·Jᵀ` with `J` from [`patch_normal`].
 pub fn patch_stiffness(p: &PatchForce) -> Matrix6<f64> {
-    let n = Vector3::from(p.frame.n);
-    at_point(n * n.transpose() * p.stiffness, Matrix3::zeros(), p.point)
+    let j = patch_normal(p);
+    j * j.transpose() * p.stiffness
 }
 
 /// `J = [n; p × n]`, track axes: the patch's normal approach rate is `Jᵀ·[v; ω]` for the

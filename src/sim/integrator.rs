@@ -27,8 +27,7 @@
 //! (`linearly-implicit-hertz`, the default): [`super::wheelset_solve`].
 
 use super::Simulation;
-pub(super) use super::wheelset_solve::Shares;
-use super::wheelset_solve::{ALPHA, Inverse, THETA, with_rails};
+use super::wheelset_solve::{ALPHA, Inverse, Shares, THETA, with_rails};
 use nalgebra::{Matrix3, Matrix6, SMatrix, UnitQuaternion, Vector2, Vector3, Vector6};
 
 /// How the bodies are integrated over a step.
@@ -43,8 +42,9 @@ pub enum Integrator {
     LinearlyImplicit,
     /// The linearly implicit step with the contact's Hertz spring in the solve too (`α·Δt²·K`,
     /// α = 0.1: no numerical damping, the wheel–rail mode's frequency right at the step), the
-    /// rail surface's passing under the wheel seen by that share: the default, at 5/7 ms (seven
-    /// steps per 200 Hz sample).
+    /// rail surface's passing under the wheel seen by that share, and each wheelset's gyroscopic
+    /// moment in the solve at the step's midpoint: the default, at 5/7 ms (seven steps per
+    /// 200 Hz sample).
     #[default]
     LinearlyImplicitHertz,
     /// Heun's method (explicit trapezoidal, second order): two force evaluations a step, the
