@@ -89,7 +89,7 @@ fn generate_resume_shard_merge_and_formats() {
     assert_eq!(kind("w3r_force_y").as_deref(), Some("wheel"));
     assert!(channels.iter().all(|c| c["unit"].is_string()));
     // The manifest says how the runs were made: the integration step and settling time.
-    assert_eq!(m["integration"]["dt_s"], 5e-3 / 7.0);
+    assert_eq!(m["integration"]["dt_s"], 5e-3 / 6.0);
     assert!(m["integration"]["settle_s"].is_number());
     assert!(m["integration"]["integrator"].is_string());
     let file = a.join("tangent_v80_seed1.npz");
@@ -130,7 +130,7 @@ fn generate_resume_shard_merge_and_formats() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("integration at 0.714") && e.contains("now 0.2 ms, semi-implicit"),
+        e.contains("integration at 0.833") && e.contains("now 0.2 ms, semi-implicit"),
         "{e}"
     );
     std::fs::remove_dir_all(&li).unwrap();

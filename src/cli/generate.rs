@@ -46,7 +46,7 @@ pub struct GenerateArgs {
     /// steps). Recorded in the manifest; a data set resumes only with the same choice.
     #[arg(long, value_parser = railforce::sim::Integrator::NAMES)]
     integrator: Option<String>,
-    /// Integration step of every run, s (default: the integrator's own, 5/7 ms linearly
+    /// Integration step of every run, s (default: the integrator's own, 5/6 ms linearly
     /// implicit Hertz, 0.5 ms linearly implicit, 0.2 ms semi-implicit or Heun).
     #[arg(long)]
     dt: Option<f64>,

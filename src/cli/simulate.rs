@@ -33,13 +33,13 @@ pub struct SimulateArgs {
     /// Settling time before recording, s (not written out).
     #[arg(long, default_value_t = 3.0)]
     settle: f64,
-    /// Integration step, s (default: the integrator's own, 5/7 ms linearly implicit Hertz,
+    /// Integration step, s (default: the integrator's own, 5/6 ms linearly implicit Hertz,
     /// 0.5 ms linearly implicit, 0.2 ms semi-implicit or Heun).
     #[arg(long)]
     dt: Option<f64>,
     /// Integrator (default: linearly-implicit-hertz): `linearly-implicit-hertz` (the wheel–rail
-    /// damping and the contact's Hertz spring, each wheelset with its rail masses, taken
-    /// implicitly: accurate at 5/7 ms, `railforce bench step`), `linearly-implicit` (the
+    /// damping and the contact's Hertz spring, each wheelset with its rail masses, and the
+    /// side frames' pad damping taken implicitly: accurate at 5/6 ms, `railforce bench step`), `linearly-implicit` (the
     /// damping alone: 0.5 ms, the default until 2026-12-04), `semi-implicit` (explicit in every
     /// force: 0.2 ms) or `heun` (second order, two force evaluations a step, explicit: a
     /// reference for small steps).

@@ -1,8 +1,8 @@
 //! Time-domain simulation of a vehicle on a track.
 //!
 //! Rigid bodies in the world frame (x, y horizontal, z up), integrated at a fixed step (default:
-//! linearly implicit in the wheel–rail damping and the contact's Hertz spring at 5/7 ms, each
-//! wheelset solved with its rail masses; the same without the Hertz spring at 0.5 ms and
+//! linearly implicit in the wheel–rail damping and the contact's Hertz spring at 5/6 ms, each
+//! wheelset solved with its rail masses and each side frame in its pads' damping; the same without the Hertz spring at 0.5 ms and
 //! semi-implicit Euler at 0.2 ms selectable: `integrator`), gyroscopic terms included
 //! (wheelsets spin).
 //! Every step the project computes all force elements and the wheel–rail contact from the body
@@ -36,6 +36,7 @@ use wheelset_solve::{RailCoupling, Shares};
 
 use crate::error::{Error, Result};
 use crate::track::Track;
+use crate::vehicle::elements::ElementDamping;
 use crate::vehicle::{BodyState, Element, Vehicle, Wrench};
 use nalgebra::{UnitQuaternion, Vector3};
 use profile::{StepProfile, timed};
@@ -164,6 +165,9 @@ pub struct Simulation<'a> {
     /// Per wheel: the rail surface's rate under it at the last step, track `(ẏ, ż)` (the
     /// linearly implicit step's; none before the first).
     surface_rates: Vec<Option<nalgebra::Vector2<f64>>>,
+    /// The stiff elements' damping the step takes implicitly, with their upper body's
+    /// velocity change once solved (the Hertz integrator's; refilled every step).
+    element_damping: Vec<(ElementDamping, nalgebra::Vector6<f64>)>,
 }
 
 impl<'a> Simulation<'a> {
@@ -312,6 +316,7 @@ impl<'a> Simulation<'a> {
             contact_damping: vec![nalgebra::Matrix6::zeros(); vehicle.contact.wheelsets.len()],
             rail_coupling: vec![RailCoupling::default(); n_wheels],
             surface_rates: vec![None; n_wheels],
+            element_damping: Vec::new(),
             shares: cfg.integrator.shares(cfg.dt),
             inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
@@ -408,7 +413,7 @@ impl<'a> Simulation<'a> {
     /// let mut sim = Simulation::new(&vehicle, &track, cfg)?;
     /// sim.settle()?;
     /// for _ in 0..1_400 {
-    ///     sim.step()?; // 1 s at the default 5/7 ms step
+    ///     sim.step()?; // 1 s at the default 5/6 ms step
     /// }
     /// println!("Q of wheel 1L: {:.1} kN", sim.wheels[0].q / 1e3);
     /// # Ok::<(), railforce::Error>(())

@@ -28,7 +28,7 @@ pub struct StepArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "2.5e-4,5e-4,6.25e-4,7.142857142857143e-4"
+        default_value = "2.5e-4,5e-4,7.142857142857143e-4,8.333333333333333e-4"
     )]
     steps: Vec<f64>,
     /// Take the rails as rigid (drop the track file's `[rail_support]`): separates the

@@ -36,7 +36,7 @@ pub type Memory = [f64; 4];
 use super::binder::Binder;
 use super::body::{Attachment, BodyState, Wrench};
 use crate::error::Result;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3};
 
 /// The registration of every force element kind, in the order a vehicle file's tables are
 /// bound (and the simulation adds their forces): variant, table name in the vehicle file, and
@@ -128,6 +128,11 @@ pub(crate) trait ForceElement: Sized {
     fn settle(&mut self, _elements: &[Element]) {}
     /// Sets its friction to zero (the sliding limit of a linear analysis).
     fn frictionless(&mut self) {}
+    /// Its damping as a linearly implicit step takes it ([`ElementDamping`]); none for the
+    /// kinds whose damping stays explicit (every kind but the stiffest).
+    fn implicit_damping(&self, _states: &[BodyState]) -> Option<ElementDamping> {
+        None
+    }
 }
 
 macro_rules! define_element {
@@ -218,6 +223,14 @@ macro_rules! define_element {
                 }
             }
 
+            /// Its damping as a linearly implicit step takes it (none where it stays explicit).
+            #[inline]
+            pub(crate) fn implicit_damping(&self, states: &[BodyState]) -> Option<ElementDamping> {
+                match self {
+                    $(Element::$variant(e) => e.implicit_damping(states),)*
+                }
+            }
+
             /// Kind name as in the vehicle file.
             pub fn kind(&self) -> &'static str {
                 match self {
@@ -255,6 +268,61 @@ impl Element {
 /// no stiffness to compress (a rigid or absent spring reads nothing).
 fn static_compression(load: f64, k: f64) -> Vector3<f64> {
     Vector3::new(0.0, 0.0, if k > 0.0 { load / k } else { 0.0 })
+}
+
+/// A stiff element's damping, linearised for a linearly implicit step: how its two bodies'
+/// wrenches (world axes, about each body's centre) change with a velocity change
+/// `Δu = (Δv, Δω)` (world) of the upper body, the lower body held: `ΔW_upper = −on_upper·Δu`,
+/// `ΔW_lower = −on_lower·Δu`. The step solves the upper body in it and hands the lower body
+/// the reaction, so the pair's momentum balances (`sim::integrator`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ElementDamping {
+    /// The upper body.
+    pub upper: usize,
+    /// The lower body.
+    pub lower: usize,
+    /// On the upper body's wrench.
+    pub on_upper: Matrix6<f64>,
+    /// On the lower body's wrench.
+    pub on_lower: Matrix6<f64>,
+}
+
+impl ElementDamping {
+    /// The damping `c` (upper axes `a`, diagonal) of a two-point element between `p_upper` and
+    /// `p_lower` (world) that [`Relative::apply`] applies: the force
+    /// `F = a·diag(c)·aᵀ·(Δv_lower − Δv_upper)` with `Δv_upper = Δv − [p_upper − x_upper]×·Δω`
+    /// the upper point's velocity change and `Δv_lower = turn·Δω` the lower point's (zero
+    /// unless the lower point turns with the upper body), on the upper body with the couple
+    /// of the points' offset (so about its centre `(p_lower − x_upper) × F`), its opposite on
+    /// the lower body at `p_lower`.
+    pub(crate) fn two_point(
+        (upper, lower): (usize, usize),
+        states: &[BodyState],
+        a: &Matrix3<f64>,
+        c: &Vector3<f64>,
+        (p_upper, p_lower): (Vector3<f64>, Vector3<f64>),
+        turn: &Matrix3<f64>,
+    ) -> Self {
+        let (xu, xl) = (states[upper].position, states[lower].position);
+        let ac = a * Matrix3::from_diagonal(c) * a.transpose();
+        let mut g = nalgebra::SMatrix::<f64, 3, 6>::zeros();
+        g.fixed_view_mut::<3, 3>(0, 0).copy_from(&ac);
+        g.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&(-ac * ((p_upper - xu).cross_matrix() + turn)));
+        let arm = |r: Vector3<f64>| {
+            let mut m = Matrix6::zeros();
+            m.fixed_view_mut::<3, 6>(0, 0).copy_from(&g);
+            m.fixed_view_mut::<3, 6>(3, 0)
+                .copy_from(&(r.cross_matrix() * g));
+            m
+        };
+        ElementDamping {
+            upper,
+            lower,
+            on_upper: arm(p_lower - xu),
+            on_lower: -arm(p_lower - xl),
+        }
+    }
 }
 
 /// Relative motion across a two-point element, in the upper body's axes.
