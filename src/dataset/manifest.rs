@@ -54,13 +54,15 @@ impl Integration {
                      support implicit, fixed step (src/sim/integrator.rs)"
                         .into()
                 }
-                Integrator::LinearlyImplicitHertz => {
+                Integrator::LinearlyImplicitHertz => format!(
                     "linearly implicit with the contact's Hertz spring: as linearly implicit, and \
-                     the contact's normal stiffness at the share 0.1 of dt^2 K seeing the rail \
-                     surface's passing, and each wheelset's gyroscopic moment at the step's \
-                     midpoint, fixed step (src/sim/wheelset_solve.rs)"
-                        .into()
-                }
+                     the contact's normal stiffness at the share {} of dt^2 K seeing the rail \
+                     surface's passing, each wheelset's gyroscopic moment at the step's \
+                     midpoint, each side frame solved in its pads' damping, every share on the \
+                     velocities relative to the turning track, fixed step \
+                     (src/sim/wheelset_solve.rs, src/sim/integrator.rs)",
+                    Integrator::LinearlyImplicitHertz.stiffness_share()
+                ),
                 Integrator::Heun => "Heun's method (explicit trapezoidal, second order), fixed step \
                      (src/sim/integrator.rs)"
                     .into(),

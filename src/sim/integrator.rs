@@ -25,7 +25,7 @@
 //!
 //! The contact's Hertz spring and the gyroscopic moment in the solve
 //! (`linearly-implicit-hertz`, the default): [`super::wheelset_solve`]. The same integrator
-//! also solves each side frame in its pads' damping (`ElementDamping`): the side frame's pitch
+//! also solves each side frame in its pads' damping ([`super::element_solve`]): the side frame's pitch
 //! and bounce on its two 200 MN/m pads (230 and 170 Hz, damping ratio 0.3–0.4) put the explicit
 //! step's limit `ω²Δt² + 4ζωΔt < 4` near 0.8 ms (a run at 5/6 ms derailed within 0.1 s);
 //! with the damping at θ = ½ it is `ω·Δt < 2`, 1.3 ms. The side frame is solved with the axle
@@ -173,21 +173,12 @@ impl Default for Stepping {
 impl Simulation<'_> {
     /// Advances every body by one step under the wrenches of the current state.
     pub(super) fn integrate(&mut self) {
-        let hertz = self.cfg.integrator == Integrator::LinearlyImplicitHertz;
-        // The Hertz integrator also takes the stiff elements' damping (the side frames on their
-        // pads) into its solve: each such element's upper body solved in it, the lower held.
-        self.element_damping.clear();
-        if hertz {
-            for e in &self.vehicle.elements {
-                if let Some(d) = e.implicit_damping(&self.states) {
-                    self.element_damping.push((d, Vector6::zeros()));
-                }
-            }
-        }
-        // Those upper bodies first, so their lower bodies take the reaction in the same step.
+        // The bodies solved in their stiff elements' damping first (the Hertz integrator's side
+        // frames, `element_solve`), so the bodies beneath take the reaction in the same step.
+        self.kicks.fill(Vector6::zeros());
         for first in [true, false] {
             for i in 0..self.states.len() {
-                if self.element_damping.iter().any(|(d, _)| d.upper == i) == first {
+                if self.damped.iter().any(|d| d.body == i) == first {
                     self.advance(i);
                 }
             }
@@ -210,15 +201,29 @@ impl Simulation<'_> {
         } else {
             None
         };
-        let damped = self.element_damping.iter().any(|(d, _)| d.upper == i);
-        // The reaction of the damping its upper bodies took in their solve (an impulse,
-        // world): `−θΔt·on_lower·Δu_upper` for each stiff element below which it hangs.
-        let mut kick = Vector6::zeros();
-        for (d, du_upper) in self.element_damping.iter().filter(|(d, _)| d.lower == i) {
-            kick -= d.on_lower * du_upper * (THETA * dt);
+        let damped = self.damped.iter().position(|d| d.body == i);
+        // The reaction of the damping the bodies above took in their solve (an impulse, world).
+        let mut kick = self.kicks[i];
+        let kicked = kick != Vector6::zeros();
+        if let Some(k) = damped {
+            // In the body's own axes, where its elements' damping is constant: the explicit
+            // change is `(Rᵀ·a·Δt, ω̇_body·Δt)`, less the track's turning.
+            let r = rot.to_rotation_matrix().into_inner();
+            let turn = self.turning(i);
+            let (tv, tw) = (turn.fixed_rows::<3>(0), turn.fixed_rows::<3>(3));
+            let (v, w) = (
+                r.transpose() * (acc * dt - tv),
+                dwb * dt - r.transpose() * tw,
+            );
+            let du = self.damped[k].change(
+                &r,
+                &Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z),
+                &mut self.kicks,
+            ) + turn;
+            self.finish(i, rot, du);
+            return;
         }
-        let kicked = self.element_damping.iter().any(|(d, _)| d.lower == i);
-        if wheelset.is_none() && !damped && !kicked {
+        if wheelset.is_none() && !kicked {
             self.accelerations[i] = acc;
             st.velocity += acc * dt;
             st.position += st.velocity * dt;
@@ -271,24 +276,16 @@ impl Simulation<'_> {
         du -= turn;
         let du = if let Some(k) = wheelset {
             self.wheelset_change(k, &body, du)
-        } else if damped {
-            let mut a = Matrix6::zeros();
-            for (d, _) in self.element_damping.iter().filter(|(d, _)| d.upper == i) {
-                a += d.on_upper * (THETA * dt);
-            }
-            body.apply(&mut a);
-            let du = (Matrix6::identity() + a).lu().solve(&du).unwrap_or(du);
-            for (_, du_upper) in self
-                .element_damping
-                .iter_mut()
-                .filter(|(d, _)| d.upper == i)
-            {
-                *du_upper = du;
-            }
-            du
         } else {
             du
         } + turn;
+        self.finish(i, rot, du);
+    }
+
+    /// Moves body `i` (at rotation `rot` at the step's start) by its velocity change `du`
+    /// (world).
+    fn finish(&mut self, i: usize, rot: UnitQuaternion<f64>, du: Vector6<f64>) {
+        let dt = self.cfg.dt;
         let st = &mut self.states[i];
         let dv = du.fixed_rows::<3>(0).into_owned();
         self.accelerations[i] = dv / dt;

@@ -15,6 +15,7 @@
 //! a direct integrator over 11 bodies costs well under a microsecond.
 
 pub mod checks;
+mod element_solve;
 pub mod fidelity;
 mod filter;
 mod integrator;
@@ -36,7 +37,6 @@ use wheelset_solve::{RailCoupling, Shares};
 
 use crate::error::{Error, Result};
 use crate::track::Track;
-use crate::vehicle::elements::ElementDamping;
 use crate::vehicle::{BodyState, Element, Vehicle, Wrench};
 use nalgebra::{UnitQuaternion, Vector3};
 use profile::{StepProfile, timed};
@@ -165,9 +165,10 @@ pub struct Simulation<'a> {
     /// Per wheel: the rail surface's rate under it at the last step, track `(ẏ, ż)` (the
     /// linearly implicit step's; none before the first).
     surface_rates: Vec<Option<nalgebra::Vector2<f64>>>,
-    /// The stiff elements' damping the step takes implicitly, with their upper body's
-    /// velocity change once solved (the Hertz integrator's; refilled every step).
-    element_damping: Vec<(ElementDamping, nalgebra::Vector6<f64>)>,
+    /// The bodies the Hertz integrator solves in their stiff elements' damping.
+    damped: Vec<element_solve::DampedBody>,
+    /// Per body: the reaction impulse of that damping in the current step, world.
+    kicks: Vec<nalgebra::Vector6<f64>>,
 }
 
 impl<'a> Simulation<'a> {
@@ -293,6 +294,11 @@ impl<'a> Simulation<'a> {
         if let Some(h) = vehicle.hauling {
             every_step.push(h.body);
         }
+        let damped = if cfg.integrator == Integrator::LinearlyImplicitHertz {
+            element_solve::damped_bodies(&vehicle.bodies, &vehicle.elements, &states, cfg.dt)
+        } else {
+            Vec::new()
+        };
         Ok(Simulation {
             frames,
             every_step,
@@ -316,7 +322,8 @@ impl<'a> Simulation<'a> {
             contact_damping: vec![nalgebra::Matrix6::zeros(); vehicle.contact.wheelsets.len()],
             rail_coupling: vec![RailCoupling::default(); n_wheels],
             surface_rates: vec![None; n_wheels],
-            element_damping: Vec::new(),
+            damped,
+            kicks: vec![nalgebra::Vector6::zeros(); n],
             shares: cfg.integrator.shares(cfg.dt),
             inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
