@@ -79,7 +79,7 @@ def simulate(
     ``time_s``); ``seed`` overrides the track file's irregularity seed. A derailment stops
     the run with ``ValueError`` unless ``keep_going``. ``integrator`` (default
     ``"linearly-implicit-hertz"``; ``"linearly-implicit"``, ``"semi-implicit"``, ``"heun"``) and
-    ``dt`` (default the integrator's own step: 5/7 ms, 0.5 ms, or 0.2 ms for the last two) as
+    ``dt`` (default the integrator's own step: 5/6 ms, 0.5 ms, or 0.2 ms for the last two) as
     the command line takes them.
     """
     cols = _native.simulate(
