@@ -52,8 +52,8 @@ impl Simulation<'_> {
     /// relative to the track centre line, m.
     fn wheels_on_rails(&self, w: usize) -> ([WheelOnRail; 2], f64) {
         let b = self.vehicle.contact.wheelsets[w];
-        let st = self.states[b];
-        let f = self.frames[b];
+        let st = &self.states[b];
+        let f = &self.frames[b];
         let rel = f.to_local(&(st.position - f.origin));
         let axle = (f.axes.transpose() * st.matrix()).column(1).into_owned();
         let (roll, yaw) = (
@@ -98,7 +98,7 @@ impl Simulation<'_> {
         let model = cs.model();
         let shares = self.shares;
         for (w, &b) in cs.wheelsets.iter().enumerate() {
-            let f = self.frames[b];
+            let f = &self.frames[b];
             let (inputs, y_centre) = self.wheels_on_rails(w);
             let mut damping = nalgebra::Matrix6::zeros();
             for (k, wr) in inputs.into_iter().enumerate() {
