@@ -88,9 +88,10 @@ fn the_c80_converges_at_second_order_with_heuns_step() {
     );
 }
 
-/// Both linearly implicit steps against the same closed form at their own default step
-/// (issue 37): the creep-damped restrained wheelset's kink dies out below Wickens' critical
-/// speed and does not above it.
+/// Constant-speed stability against Wickens' closed form, for both linearly implicit steps at
+/// their own default step (the default integrator among them; issue 37): the creep-damped
+/// restrained wheelset's kink dies out below its critical speed and does not above it (grows
+/// to a cycle or off the cones).
 #[test]
 #[ignore = "long simulation: run in release"]
 fn linearly_implicit_steps_keep_wickens_speed() {
@@ -116,7 +117,7 @@ fn linearly_implicit_steps_keep_wickens_speed() {
 }
 
 /// The linearly implicit steps at their own default step (0.5 ms; the default's, with the
-/// contact's Hertz spring, at 5/7 ms) against the semi-implicit one at 0.05 ms (issue 37's
+/// contact's Hertz spring, at 5/6 ms) against the semi-implicit one at 0.05 ms (issue 37's
 /// yardstick), on three conditions: the R 400 m curve at 40 km/h, where creep is stiffest, and
 /// at 80 km/h, where the trailing wheels' lateral force rides on the compliant rails (the
 /// condition the rails' former backward-Euler Hertz spring put 3.7 % off), and tangent track
@@ -154,7 +155,7 @@ fn linearly_implicit_steps_keep_the_statistics() {
             let d = new.trials[0].outcome.clone().unwrap();
             let stats = |d: &fidelity::StepDifference| [d.yq_rms, d.q_sd, d.label_y_sd];
             // Measured 2026-12-04, 20 s, 0.5 ms: at most 0.11 % (40 km/h), 0.27 % (R 400 m,
-            // 80 km/h); 60 s, 5/7 ms with the Hertz spring: see README "Speed".
+            // 80 km/h); 60 s, 5/6 ms with the Hertz spring: see README "Speed".
             let limit = 0.01;
             let old = study(Integrator::SemiImplicit);
             for (k, a) in stats(&d).into_iter().enumerate() {
