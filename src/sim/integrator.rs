@@ -160,7 +160,7 @@ impl Stepping {
 }
 
 impl Default for Stepping {
-    /// The default run's: linearly implicit at 0.5 ms.
+    /// The default run's: the default integrator at its own step (`SimConfig::default`).
     fn default() -> Self {
         let cfg = super::SimConfig::default();
         Stepping {
