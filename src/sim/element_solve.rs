@@ -12,7 +12,7 @@
 //! instead, the eight pads and four 6×6 solves took the C80's integration from 2.1 to 4.8 µs a
 //! step (`bench simulate`'s profile).
 
-use super::wheelset_solve::THETA;
+use super::wheelset_solve::{THETA, to_world};
 use crate::vehicle::elements::{Element, ElementDamping};
 use crate::vehicle::{Body, BodyState};
 use nalgebra::{Matrix3, Matrix6, Vector6};
@@ -29,14 +29,8 @@ pub(super) struct DampedBody {
     reactions: Vec<(usize, Matrix6<f64>)>,
 }
 
-/// `[R, 0; 0, R]`: a pair of 3-vectors (velocity and angular velocity, or force and moment)
-/// from body axes `R` to the world.
-fn both(r: &Matrix3<f64>, u: &Vector6<f64>) -> Vector6<f64> {
-    let (a, b) = (r * u.fixed_rows::<3>(0), r * u.fixed_rows::<3>(3));
-    Vector6::new(a.x, a.y, a.z, b.x, b.y, b.z)
-}
-
-/// A 6×6 map between such pairs, world axes, read in body axes `R`: `Bᵀ·M·B`.
+/// A 6×6 map between pairs of 3-vectors (velocity and angular velocity, force and moment),
+/// world axes, read in body axes `R`: `Bᵀ·M·B` with `B = [R, 0; 0, R]`.
 fn to_body(r: &Matrix3<f64>, m: &Matrix6<f64>) -> Matrix6<f64> {
     let mut b = Matrix6::zeros();
     b.fixed_view_mut::<3, 3>(0, 0).copy_from(r);
@@ -99,8 +93,8 @@ impl DampedBody {
     ) -> Vector6<f64> {
         let solved = self.solve * du;
         for (lower, m) in &self.reactions {
-            kicks[*lower] += both(r, &(m * solved));
+            kicks[*lower] += to_world(&(m * solved), r);
         }
-        both(r, &solved)
+        to_world(&solved, r)
     }
 }

@@ -107,8 +107,11 @@ impl RailCoupling {
     }
 }
 
-/// A wrench in track axes `(F, M)` in world axes.
-fn to_world(w: &nalgebra::Vector6<f64>, a: &nalgebra::Matrix3<f64>) -> nalgebra::Vector6<f64> {
+/// A pair of 3-vectors in axes `a` (a wrench `(F, M)`, or a velocity `(v, ω)`) in world axes.
+pub(super) fn to_world(
+    w: &nalgebra::Vector6<f64>,
+    a: &nalgebra::Matrix3<f64>,
+) -> nalgebra::Vector6<f64> {
     let (f, m) = (a * w.fixed_rows::<3>(0), a * w.fixed_rows::<3>(3));
     nalgebra::Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
 }
