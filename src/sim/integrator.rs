@@ -120,6 +120,13 @@ impl Integrator {
         )
     }
 
+    /// Whether the step takes the Hertz variant's additions beside the contact's Hertz share:
+    /// the rail surface's passing, the wheelsets' gyroscopic moment, the side frames in their
+    /// pads' damping and the shares relative to the turning track.
+    pub(super) fn solves_bogie(self) -> bool {
+        self == Integrator::LinearlyImplicitHertz
+    }
+
     /// `α`, the share of the contact's Hertz spring the solve takes (`α·Δt²·K`; 0 where the
     /// spring is explicit).
     pub fn stiffness_share(self) -> f64 {
@@ -245,7 +252,7 @@ impl Simulation<'_> {
             dw_explicit.y,
             dw_explicit.z,
         );
-        let hertz = self.cfg.integrator == Integrator::LinearlyImplicitHertz;
+        let hertz = self.cfg.integrator.solves_bogie();
         let gyroscopic = if hertz && wheelset.is_some() {
             // The gyroscopic moment in the solve at θ (its slope in ω:
             // ∂(ω × I·ω)/∂ω = [ω]×·I − [I·ω]×): explicit, the spin's coupling of roll and
@@ -317,7 +324,7 @@ impl Simulation<'_> {
     fn wheelset_change(&mut self, k: usize, body: &Inverse, du: Vector6<f64>) -> Vector6<f64> {
         let dt = self.cfg.dt;
         let d = &self.contact_damping[k];
-        let hertz = self.cfg.integrator == Integrator::LinearlyImplicitHertz;
+        let hertz = self.cfg.integrator.solves_bogie();
         // The rail surface's rate under each wheel changes over the step as the wheel rolls
         // on (the irregularity's curvature): the normal law's share in the solve sees that
         // change as it sees a rail mass's, else it acts on the wheel's following of the

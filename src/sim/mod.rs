@@ -294,7 +294,7 @@ impl<'a> Simulation<'a> {
         if let Some(h) = vehicle.hauling {
             every_step.push(h.body);
         }
-        let damped = if cfg.integrator == Integrator::LinearlyImplicitHertz {
+        let damped = if cfg.integrator.solves_bogie() {
             element_solve::damped_bodies(&vehicle.bodies, &vehicle.elements, &states, cfg.dt)
         } else {
             Vec::new()
