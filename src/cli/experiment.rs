@@ -87,9 +87,12 @@ pub struct ExperimentArgs {
     /// do not depend on how many run at once).
     #[arg(long, default_value_t = 2)]
     jobs: usize,
-    /// Label at the last step of the window (causal, usable on board in real time) instead of
-    /// the centre step (the paper's).
-    #[arg(long)]
+    /// Where a window's label sits: `centre` (the paper's, the default, as `train` and
+    /// Python's `windows()`) or `last` (causal, usable on board in real time).
+    #[arg(long, default_value = "centre", value_parser = railforce::features::LabelAt::NAMES)]
+    label: String,
+    /// The former spelling of `--label last`.
+    #[arg(long, hide = true)]
     last_label: bool,
     /// Window length, steps (the paper's 20 at 200 Hz = 0.1 s; longer windows average more
     /// noise out and cost proportionally more time).
@@ -153,9 +156,11 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
         opts.mismatch_window = w;
     }
     opts.mismatch_members = args.mismatch_members.into();
-    if args.last_label {
-        opts.label_at = railforce::features::LabelAt::Last;
-    }
+    opts.label_at = if args.last_label {
+        railforce::features::LabelAt::Last
+    } else {
+        railforce::features::LabelAt::parse(&args.label)?
+    };
     opts.snr_reference = SnrReference::parse(&args.snr_reference)
         .ok_or_else(|| anyhow::anyhow!("--snr-reference {}: std or rms", args.snr_reference))?;
     if !(args.train_seeds.is_empty() && args.val_seeds.is_empty() && args.test_seeds.is_empty()) {

@@ -29,8 +29,12 @@ pub struct SelectArgs {
     /// Window length, steps.
     #[arg(long, default_value_t = 20)]
     window: usize,
-    /// Label at the centre step of the window (non-causal) instead of the last.
-    #[arg(long)]
+    /// Where a window's label sits: `centre` (the paper's, the default) or `last` (causal);
+    /// `train` with this selection uses the same.
+    #[arg(long, default_value = "centre", value_parser = LabelAt::NAMES)]
+    label: String,
+    /// The former spelling of `--label centre`.
+    #[arg(long, hide = true)]
     centre_label: bool,
     /// The signals to choose from: `paper21` (the paper's 21) or `onboard` (every on-board
     /// measurable signal: body accelerations, angular rates, track-relative displacements
@@ -64,7 +68,7 @@ pub fn run(args: SelectArgs) -> Result<()> {
         label_at: if args.centre_label {
             LabelAt::Centre
         } else {
-            LabelAt::Last
+            LabelAt::parse(&args.label)?
         },
         candidates,
         mi_samples: args.mi_samples,

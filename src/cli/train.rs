@@ -60,9 +60,13 @@ pub struct DataArgs {
     /// Stride of the training windows (validation and test always use 1).
     #[arg(long, default_value_t = 1)]
     pub stride: usize,
-    /// Label at the centre step of the window (non-causal, as the paper reads) instead of the
-    /// selection's (or the last step).
-    #[arg(long)]
+    /// Where a window's label sits: `centre` (the paper's intermediate time point, the
+    /// default, as Python's `windows()` and the experiments) or `last` (causal, usable on
+    /// board in real time). Without it, the selection's position, or the centre.
+    #[arg(long, value_parser = LabelAt::NAMES)]
+    pub label: Option<String>,
+    /// The former spelling of `--label centre`.
+    #[arg(long, hide = true, conflicts_with = "label")]
     pub centre_label: bool,
     /// Window length, steps, instead of the selection's (or 20).
     #[arg(long)]
@@ -149,7 +153,7 @@ pub struct TrainArgs {
 }
 
 /// The data options as the library's request: the selection file's channels, window and
-/// label position (or the paper's 21, 20, last), then the flags that override them.
+/// label position (or the paper's 21, 20, the centre), then the flags that override them.
 pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
     let (channels, window, label_at) = match &args.selection {
         Some(p) => {
@@ -159,7 +163,7 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
         None => (
             PAPER_CHANNELS.iter().map(|c| c.to_string()).collect(),
             20,
-            LabelAt::Last,
+            LabelAt::default(),
         ),
     };
     let noise = match args.noise.as_deref() {
@@ -172,10 +176,10 @@ pub fn data_spec(args: &DataArgs, ds: &DataSet) -> Result<DataSpec> {
         channels,
         targets: args.target.clone(),
         window: args.window.unwrap_or(window),
-        label_at: if args.centre_label {
-            LabelAt::Centre
-        } else {
-            label_at
+        label_at: match (&args.label, args.centre_label) {
+            (Some(name), _) => LabelAt::parse(name)?,
+            (None, true) => LabelAt::Centre,
+            (None, false) => label_at,
         },
         stride: args.stride,
         split: split(args, ds)?,

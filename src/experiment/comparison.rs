@@ -56,6 +56,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     .join(format!("{}_{}", kind.name(), ["fl", "fq"][k])),
                 windows: Some(opts.condition_windows_per_epoch),
                 members: 1,
+                seed_offset: 0,
             });
         }
     }

@@ -22,7 +22,7 @@ impl Ctx<'_> {
         kind: ModelKind,
         dir: &Path,
         windows_per_epoch: Option<usize>,
-        member: usize,
+        seed_offset: u64,
     ) -> Result<(Model, f64)> {
         let t0 = Instant::now();
         let name = dir
@@ -36,8 +36,9 @@ impl Ctx<'_> {
                 .noise_model
                 .filter(|_| self.opts.fresh_noise && spec.noise == NoiseProtocol::Matched),
             windows_per_epoch: windows_per_epoch.or(self.opts.train.windows_per_epoch),
-            // An ensemble's members from seeds seed, seed + 1, … (as `train --ensemble`).
-            seed: self.opts.train.seed + member as u64,
+            // An ensemble's members from seeds seed, seed + 1, … (as `train --ensemble`), a
+            // job's own offset added (a second seed of the same model).
+            seed: self.opts.train.seed + seed_offset,
             ..self.opts.train.clone()
         };
         let mut model = train(ds, spec, kind, &opts, dir, &mut |p| {
@@ -95,7 +96,14 @@ impl Ctx<'_> {
                         } else {
                             job.dir.join(format!("member{}", k + 1))
                         };
-                        let r = self.fit(job.ds, &job.spec, job.kind, &dir, job.windows, k);
+                        let r = self.fit(
+                            job.ds,
+                            &job.spec,
+                            job.kind,
+                            &dir,
+                            job.windows,
+                            job.seed_offset + k as u64,
+                        );
                         let failed = r.is_err();
                         done.lock().expect("results lock")[t] = Some(r);
                         if failed {
@@ -141,4 +149,7 @@ pub(super) struct FitJob<'d> {
     pub(super) windows: Option<usize>,
     /// Networks from seeds seed, seed + 1, … joined into one ensemble (1: one network).
     pub(super) members: usize,
+    /// Added to the training seed (0: the experiments' seed; 1: a second training of the
+    /// same model, for the spread over seeds).
+    pub(super) seed_offset: u64,
 }

@@ -322,6 +322,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             dir: dir.join(format!("models/{name}")),
             windows: None,
             members,
+            seed_offset: 0,
         })
     };
     let mut jobs = Vec::new();

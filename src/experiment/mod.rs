@@ -347,6 +347,35 @@ fn train_metrics(model: &mut Model, ds: &DataSet) -> Result<Vec<Metrics>> {
     Ok(metrics(&y, &p, &stats.1))
 }
 
+/// Seconds since 1970-01-01 UTC (0 when the clock is before it).
+fn unix_now() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs())
+}
+
+/// The commit of the source tree the run was started in (`git rev-parse HEAD`, with
+/// `-modified` when tracked files differ from it), or "unknown" outside a git checkout: the
+/// results snapshot names the code that measured it.
+fn source_commit() -> String {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    match git(&["rev-parse", "HEAD"]) {
+        Some(h) if !h.is_empty() => {
+            let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
+                .is_some_and(|s| !s.is_empty());
+            if dirty { format!("{h}-modified") } else { h }
+        }
+        _ => "unknown".into(),
+    }
+}
+
 fn f4(v: f64) -> String {
     format!("{v:.4}")
 }
@@ -447,6 +476,8 @@ pub fn run(
         "mismatch_members": opts.mismatch_members,
         "fresh_noise_every_epoch": opts.fresh_noise,
         "railforce_version": env!("CARGO_PKG_VERSION"),
+        "commit": source_commit(),
+        "started_unix": unix_now(),
     });
     for part in parts.clone() {
         let ts = Instant::now();
@@ -486,6 +517,7 @@ pub fn run(
     let wall = t0.elapsed().as_secs_f64();
     let mut meta = common.clone();
     meta["wall_seconds"] = json!(wall);
+    meta["finished_unix"] = json!(unix_now());
     meta["timings"] = json!(timings);
     let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");
     crate::io::write_atomic(&opts.out.join("meta.json"), |w| w.write_all(mj.as_bytes()))?;

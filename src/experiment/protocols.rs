@@ -73,6 +73,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 dir: dir.join(format!("models/{}", split.name())),
                 windows: None,
                 members: 1,
+                seed_offset: 0,
             })
         })
         .collect::<Result<Vec<_>>>()?;

@@ -52,6 +52,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             dir: dir.join(format!("models/clean_{}", kind.name())),
             windows,
             members: 1,
+            seed_offset: 0,
         });
     }
     for &kind in &opts.robustness_models {
@@ -69,6 +70,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 dir: dir.join(format!("models/matched_{}_{snr}dB", kind.name())),
                 windows,
                 members: 1,
+                seed_offset: 0,
             });
         }
     }

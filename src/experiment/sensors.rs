@@ -79,6 +79,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 )),
                 windows: None,
                 members: 1,
+                seed_offset: 0,
             })
         })
         .collect::<Result<Vec<_>>>()?;

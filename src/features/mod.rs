@@ -93,7 +93,7 @@ impl Default for SelectOptions {
             mi_threshold: 0.01,
             tolerance: 0.002,
             window: 20,
-            label_at: LabelAt::Last,
+            label_at: LabelAt::default(),
             mi_samples: 50_000,
             max_windows: 40_000,
             candidates: Candidates::Paper21,

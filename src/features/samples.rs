@@ -10,13 +10,40 @@ use crate::dataset::DataSet;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
-/// Where the label of a window sits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// Where the label of a window sits. The default is the centre, the paper's "intermediate
+/// time point", in every front end (`train --label`, Python's `windows(label=…)`,
+/// `WindowDataset`, the experiments).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum LabelAt {
     /// The last step (causal: usable on board in real time).
     Last,
     /// The centre step (non-causal, as the paper reads).
+    #[default]
     Centre,
+}
+
+impl LabelAt {
+    /// The names both front ends accept, the default first.
+    pub const NAMES: [&'static str; 2] = ["centre", "last"];
+
+    /// The position a name gives (`centre`, `center` or `last`); the error names the choices.
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "centre" | "center" => Ok(LabelAt::Centre),
+            "last" => Ok(LabelAt::Last),
+            _ => Err(Error::Domain(format!(
+                "label {name}: centre (the paper's, the default) or last (causal)"
+            ))),
+        }
+    }
+
+    /// The name [`Self::parse`] reads back.
+    pub fn name(self) -> &'static str {
+        match self {
+            LabelAt::Centre => "centre",
+            LabelAt::Last => "last",
+        }
+    }
 }
 
 /// A window: steps `start .. start + window` of run `run`.

@@ -203,15 +203,7 @@ fn windows<'py>(
                 )));
             }
         };
-        let label_at = match label {
-            "centre" | "center" => LabelAt::Centre,
-            "last" => LabelAt::Last,
-            _ => {
-                return Err(PyValueError::new_err(format!(
-                    "label {label}: centre (the paper's) or last (causal)"
-                )));
-            }
-        };
+        let label_at = LabelAt::parse(label).map_err(|e| PyValueError::new_err(e.to_string()))?;
         let noise = noise
             .map(|n| {
                 NoiseProtocol::parse(n).ok_or_else(|| {
