@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One network, quantile heads and a 5-member ensemble, trained on the same data set with the
 # same protocol, each timed and evaluated on the test seed: coverage of the 90 % interval and
-# its mean width (issue 36: which is better per unit of training time).
+# its mean width: which is better per unit of training time.
 #   examples/compare_uncertainty.sh [DATA] [OUT]     (DATA: generate --plan demo --snr-db 6)
 # Environment: SEED (first seed, default 1), CONFIGS (which of single, quantile-heads,
 # ensemble5; default all three), TRAIN_ARGS (more `train` options, e.g. the experiments'
@@ -15,15 +15,15 @@ CONFIGS=${CONFIGS:-single quantile-heads ensemble5}
 mkdir -p "$O"
 for name in $CONFIGS; do
   case $name in
-    single) args="" ;;
-    quantile-heads) args="--quantile-heads" ;;
+    single) args="--no-quantile-heads" ;;
+    quantile-heads) args="--quantile-heads 0.9" ;;
     ensemble5) args="--ensemble 5" ;;
     *) echo "unknown configuration $name (single, quantile-heads, ensemble5)" >&2; exit 2 ;;
   esac
   out="$O/${name}_seed$SEED"
   t0=$(date +%s.%N)
   # shellcheck disable=SC2086
-  "$R" train --data "$D" --model cnn-bilstm --centre-label --seed "$SEED" --out "$out" --force $args ${TRAIN_ARGS:-} > "$out.train.log" 2>&1
+  "$R" train --data "$D" --model cnn-bilstm --label centre --seed "$SEED" --out "$out" --force $args ${TRAIN_ARGS:-} > "$out.train.log" 2>&1
   t1=$(date +%s.%N)
   "$R" evaluate --model "$out" --data "$D" > "$out.eval.log" 2>&1
   printf '%s (seed %s): trained in %.0f s; pooled R² %s; %s\n' "$name" "$SEED" "$(echo "$t1 - $t0" | bc)" \

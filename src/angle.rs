@@ -3,7 +3,7 @@
 //! polynomials where the argument is small enough that the first omitted term is under half a
 //! unit in the last place, the standard library elsewhere. The step evaluates some forty of
 //! them; the polynomials take a few multiply-adds where the library's general routines take
-//! tens of nanoseconds (issue 37).
+//! tens of nanoseconds.
 
 /// Largest |x| the polynomials serve (rad; for [`asin`] the sine, for [`atan2`] the ratio
 /// `y/x`). The first omitted terms there, `x¹¹/11!` ≈ 3·10⁻¹⁹ (sine), `x¹²/12!` ≈ 2·10⁻²¹

@@ -16,6 +16,8 @@ mod common;
 mod contact;
 #[path = "dataset.rs"]
 mod dataset;
+#[path = "docs.rs"]
+mod docs;
 #[path = "dynamics.rs"]
 mod dynamics;
 #[path = "experiment.rs"]

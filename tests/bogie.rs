@@ -1,4 +1,4 @@
-//! The three-piece bogie's parts as built against their closed forms (issues 17, 33): the side
+//! The three-piece bogie's parts as built against their closed forms: the side
 //! frame hanging on its pads (gravity's roll and swing stiffness), the shear pad's resistance to
 //! the side frame rolling on it, the two-stage nest and the control springs that press the
 //! wedges, the centre plate's and side bearers' friction that sticks, then slips at its limit;
@@ -250,8 +250,8 @@ fn moment_about_pad_line(
 
 /// A side frame rolled about the line of its pads: gravity returns it with `W·L` (the load
 /// W on its spring seat L below the pedestal roofs) plus `m·g·h` (its own weight h below), and
-/// each pad adds its own terms ([`pad_terms`]) (issue 33: the side frame hangs; it stood as an
-/// inverted pendulum when the pads acted at the axle centre and the nest above them).
+/// each pad adds its own terms ([`pad_terms`]). The side frame hangs: with the pads acting at
+/// the axle centre and the nest above them it would stand as an inverted pendulum.
 #[test]
 fn side_frame_hangs_roll_stiffness_about_the_pad_line() {
     for v in [c80(), c80_empty()] {

@@ -477,16 +477,16 @@ fn float32_subset_keeps_values_to_float32_precision() {
     );
 }
 
-/// The typed manifest reads every manifest the previous code wrote: today's format (written
-/// back byte for byte), the 2026-12-01 one with each run's wall time (read and dropped), the
-/// 2026-11-27 one without `integration`, and the first writer's of
-/// 2026-11-22 without the data-set options, the noise reference, the accelerometer setting,
-/// the label wheel and each run's vehicle, class and start.
+/// The typed manifest reads every manifest format railforce has written: format 4 (written
+/// back byte for byte), format 3 with each run's wall time (read and dropped), format 2
+/// without `integration`, and the first writer's format 1 without the data-set options, the
+/// noise reference, the accelerometer setting, the label wheel and each run's vehicle, class
+/// and start.
 #[test]
 fn typed_manifest_reads_every_format() {
     let dir = root().join("tests/fixtures/manifests");
-    let today = dir.join("2026-12-02.json");
-    let m = Manifest::read(&today).unwrap().unwrap();
+    let current = dir.join("format4.json");
+    let m = Manifest::read(&current).unwrap().unwrap();
     let integration = m.integration.as_ref().unwrap();
     assert_eq!(integration.dt_s, 2e-4);
     assert_eq!(m.labels(), ["w1l_force_y", "w1l_force_z"]);
@@ -494,7 +494,7 @@ fn typed_manifest_reads_every_format() {
         m.conventions.labels.as_ref().unwrap().wheel.as_deref(),
         Some("1L")
     );
-    let noise = m.noise_model(&today).unwrap().unwrap();
+    let noise = m.noise_model(&current).unwrap().unwrap();
     assert_eq!((noise.snr_db, noise.reference), (6.0, SnrReference::Std));
     assert_eq!(m.runs.len(), 2);
     assert_eq!(m.runs[0].vehicle.as_deref(), Some("C80 loaded (100 t)"));
@@ -503,25 +503,25 @@ fn typed_manifest_reads_every_format() {
     m.write(&back).unwrap();
     assert_eq!(
         std::fs::read_to_string(&back).unwrap(),
-        std::fs::read_to_string(&today).unwrap(),
+        std::fs::read_to_string(&current).unwrap(),
         "the typed manifest writes the untyped writer's bytes"
     );
 
-    let dec01 = Manifest::read(&dir.join("2026-12-01.json"))
+    let format3 = Manifest::read(&dir.join("format3-run-wall-times.json"))
         .unwrap()
         .unwrap();
     assert_eq!(
-        dec01, m,
-        "the wall times of 2026-12-01 are read and dropped"
+        format3, m,
+        "the wall times of format 3 are read and dropped"
     );
 
-    let nov27 = Manifest::read(&dir.join("2026-11-27.json"))
+    let format2 = Manifest::read(&dir.join("format2-no-integration.json"))
         .unwrap()
         .unwrap();
-    assert!(nov27.integration.is_none());
-    assert_eq!(nov27.runs, m.runs);
+    assert!(format2.integration.is_none());
+    assert_eq!(format2.runs, m.runs);
 
-    let first = dir.join("2026-11-22.json");
+    let first = dir.join("format1-first-writer.json");
     let old = Manifest::read(&first).unwrap().unwrap();
     assert_eq!(old.dataset, railforce::plan::DatasetOptions::default());
     assert_eq!(old.labels(), ["w1l_force_y", "w1l_force_z"]);
@@ -541,7 +541,7 @@ fn typed_manifest_reads_every_format() {
 #[test]
 fn unreadable_manifest_field_is_named() {
     let text =
-        std::fs::read_to_string(root().join("tests/fixtures/manifests/2026-12-02.json")).unwrap();
+        std::fs::read_to_string(root().join("tests/fixtures/manifests/format4.json")).unwrap();
     let tmp = temp("manifest_bad_field");
     for (from, to, field) in [
         ("\"snr_db\": 6.0", "\"snr_db\": \"six\"", "snr_db"),

@@ -155,7 +155,7 @@ fn filter_and_wrapper_find_the_informative_channels() {
     assert!(e.contains("unknown channel 'nonsense'"), "{e}");
 }
 
-/// The noise protocols and the shuffled split are decided in the library (issue 34): the
+/// The noise protocols and the shuffled split are decided in the library: the
 /// names `train --noise` takes parse, others are refused, and the shuffled split keeps
 /// 70 / 15 % for training and validation.
 #[test]

@@ -1,4 +1,4 @@
-//! Issue 17: the three-piece bogie's parts and the track against closed forms, the one contact
+//! The three-piece bogie's parts and the track against closed forms, the one contact
 //! evaluation (continuous, and the same in a run and in `railforce contact`), and (ignored,
 //! release) the simulator's fidelity checks.
 
@@ -103,11 +103,11 @@ fn wedge_slider_sticks_then_slips_at_the_friction_limit() {
 
 /// A damped slider (the wedge's: stick spring and damper in parallel, in series with the
 /// slider) slipping in two dimensions while its velocity turns: the force must not depend on
-/// the step it is sampled at. The former return map reset the spring to the limit each step,
-/// dropping the damper's share, so the force swung toward the velocity by `c·|v|/limit` per
-/// step: here its direction at 0.05 / 0.2 / 0.4 ms was 2.2 / 11.9 / 19.8 mrad off the 0.025 ms
-/// one. Now the lag behind the velocity is the elasto-plastic one, `k·|v|/limit` of relaxation
-/// rate against the turn rate (2/40 = 50 mrad), at every step.
+/// the step it is sampled at. A return map that reset the spring to the limit each step would
+/// drop the damper's share, so the force would swing toward the velocity by `c·|v|/limit` per
+/// step (measured: 2.2 / 11.9 / 19.8 mrad off the 0.025 ms direction at 0.05 / 0.2 / 0.4 ms).
+/// The lag behind the velocity is the elasto-plastic one, `k·|v|/limit` of relaxation rate
+/// against the turn rate (2/40 = 50 mrad), at every step.
 #[test]
 fn a_damped_slider_slips_the_same_at_any_step() {
     use nalgebra::Vector2;
@@ -332,8 +332,9 @@ fn fidelity_checks_hold() {
         fidelity::yq_and_q(&base, 8).unwrap(),
         fidelity::yq_and_q(&fine, 8).unwrap(),
     );
-    // Every wheel within 1 % (issue 17). Measured: leading 0.40 %, trailing 0.32 %; with the
-    // former 150 kg lateral rail mass the trailing ones were 2.85 % off (assets/docs/stability.md).
+    // Every wheel within 1 %. Measured: leading 0.40 %, trailing 0.32 %. The track files'
+    // lateral rail mass decides the trailing ones: with 150 kg instead of the files' 243 kg
+    // they measured 2.85 % off at the semi-implicit 0.2 ms step (CHANGELOG.md).
     let tol = 0.01;
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         assert!(
@@ -354,8 +355,8 @@ fn fidelity_checks_hold() {
     // Kink-and-coast from 200 km/h at 2 m/s² (as `validate dynamics`): the loaded wagon
     // hunts and its limit cycle dies out on the way down (measured 85 km/h); the empty one,
     // its bogies held by the cross-bracing and the sticking side bearers, does not hunt at
-    // the files' conicity of 0.018. Issues 17 and 33 asked for the empty wagon first: it is,
-    // at 1 360 mm flange back (assets/docs/stability.md).
+    // the files' conicity of 0.018. The empty wagon's critical speed is the lower one at
+    // 1 360 mm flange back (assets/docs/stability.md).
     let smooth = fidelity::smooth(Path::new(&root().join("tracks/tangent.toml"))).unwrap();
     let empty = Vehicle::load(&root().join("vehicles/c80_empty.toml")).unwrap();
     let e = fidelity::critical_speed(&empty, &smooth, 200.0 / 3.6, 50.0 / 3.6, 2.0).unwrap();
@@ -383,18 +384,18 @@ fn fidelity_checks_hold() {
     );
     let e = fidelity::run_down(&empty, &smooth, 200.0 / 3.6, 50.0 / 3.6, 1.5).unwrap();
     assert!(e.critical.is_none(), "empty run-down: {:?}", e.critical);
-    // Held at 90 and 120 km/h after the kink, the loaded wagon settles (issue 17: it kept a
-    // 1.2 Hz carbody sway while its side frames rolled freely on point-spring pads).
+    // Held at 90 and 120 km/h after the kink, the loaded wagon settles (side frames rolling
+    // freely on point-spring pads would keep a 1.2 Hz carbody sway).
     for kmh in [90.0, 120.0] {
         let st = fidelity::settled(v, &smooth, kmh / 3.6, 35.0, 5.0).unwrap();
         assert!(!st.cycling(), "{kmh} km/h: {st:?}");
     }
 }
 
-/// The side frames hang on their pads (issue 33): on class-5 track, tangent at 80 km/h and
+/// The side frames hang on their pads: on class-5 track, tangent at 80 km/h and
 /// R 400 m at 60 km/h, loaded and empty, their roll relative to the track stays within a
-/// standard deviation of 8 mrad and a peak of 25 mrad (measured 2.0–2.6 / 7.2–8.0 mrad; on
-/// the one-point elements before, 61 / 165 mrad loaded on tangent), as `validate dynamics`.
+/// standard deviation of 8 mrad and a peak of 25 mrad, as `validate dynamics` judges them (its
+/// measured figures: assets/docs/validation.md).
 #[test]
 #[ignore = "long simulation: run in release"]
 fn side_frames_roll_well_under_a_degree() {
@@ -416,7 +417,7 @@ fn side_frames_roll_well_under_a_degree() {
     }
 }
 
-/// A stiff spring–mass at each linearly implicit step's default step (issue 37): a free
+/// A stiff spring–mass at each linearly implicit step's default step: a free
 /// wheelset bouncing on its two contact springs (about 110 Hz; the Hertz spring explicit at
 /// 0.5 ms, in the solve at the share α at 5/6 ms, its damper in the solve at both) against the
 /// closed form of a damped oscillator: frequency `ω·√(1 − ζ²)`, `ω = √(k/m)` with `k` the

@@ -1,4 +1,4 @@
-//! Issue 37: the integrators against their own finer steps and against closed forms. Heun's
+//! The integrators against their own finer steps and against closed forms. Heun's
 //! step is second order, the semi-implicit one first order; with the wedges' step-independent
 //! slider the C80 converges like the scheme that carries it. The linearly implicit steps keep
 //! Wickens' critical speed, the statistics of the fine step and a steady curve's load
@@ -32,7 +32,7 @@ fn difference(s: &StepStudy, i: usize) -> StepDifference {
 }
 
 /// Halving the step divides Heun's error by about four and the semi-implicit step's by about
-/// two, on the restrained wheelset (linear creep, 1:40 cones; measured 2026-12-04, 10 s at
+/// two, on the restrained wheelset (linear creep, 1:40 cones; measured over 10 s at
 /// 80 km/h against Heun at 0.025 ms: Heun Y/Q rms 0.09 → 0.32 %, Q std 0.18 → 0.76 % from 0.1
 /// to 0.2 ms; semi-implicit 0.45 → 1.02 %, 0.05 → 0.08 %).
 #[test]
@@ -64,9 +64,9 @@ fn heun_step_is_second_order_and_the_semi_implicit_first() {
 }
 
 /// The C80 with its friction elements converges with Heun's step as a smooth system does:
-/// within 0.1 % at 0.2 ms of Heun at 0.05 ms (measured 0.03 % Y/Q rms over 20 s). With the
-/// former slider, which dropped its damper's share at every step, it was 1.33 % at 0.2 ms and
-/// first order.
+/// within 0.1 % at 0.2 ms of Heun at 0.05 ms (measured 0.03 % Y/Q rms over 20 s). A slider
+/// that dropped its damper's share at every step would make it first order (measured 1.33 % at
+/// 0.2 ms).
 #[test]
 #[ignore = "long simulation: run in release"]
 fn the_c80_converges_at_second_order_with_heuns_step() {
@@ -89,7 +89,7 @@ fn the_c80_converges_at_second_order_with_heuns_step() {
 }
 
 /// Constant-speed stability against Wickens' closed form, for both linearly implicit steps at
-/// their own default step (the default integrator among them; issue 37): the creep-damped
+/// their own default step (the default integrator among them): the creep-damped
 /// restrained wheelset's kink dies out below its critical speed and does not above it (grows
 /// to a cycle or off the cones).
 #[test]
@@ -117,10 +117,10 @@ fn linearly_implicit_steps_keep_wickens_speed() {
 }
 
 /// The linearly implicit steps at their own default step (0.5 ms; the default's, with the
-/// contact's Hertz spring, at 5/6 ms) against the semi-implicit one at 0.05 ms (issue 37's
+/// contact's Hertz spring, at 5/6 ms) against the semi-implicit one at 0.05 ms (the
 /// yardstick), on three conditions: the R 400 m curve at 40 km/h, where creep is stiffest, and
 /// at 80 km/h, where the trailing wheels' lateral force rides on the compliant rails (the
-/// condition the rails' former backward-Euler Hertz spring put 3.7 % off), and tangent track
+/// condition a backward-Euler Hertz spring on the rails puts 3.7 % off), and tangent track
 /// at 80 km/h. Every wheel's Y/Q rms and Q standard deviation and FL's standard deviation stay
 /// within 1 % and closer than the semi-implicit step's at the same step; no power above 40 Hz
 /// gained.
@@ -154,8 +154,8 @@ fn linearly_implicit_steps_keep_the_statistics() {
             let new = study(integrator);
             let d = new.trials[0].outcome.clone().unwrap();
             let stats = |d: &fidelity::StepDifference| [d.yq_rms, d.q_sd, d.label_y_sd];
-            // Measured 2026-12-04, 20 s, 0.5 ms: at most 0.11 % (40 km/h), 0.27 % (R 400 m,
-            // 80 km/h); 60 s, 5/6 ms with the Hertz spring: see README "Speed".
+            // Measured over 20 s at 0.5 ms: at most 0.11 % (40 km/h), 0.27 % (R 400 m,
+            // 80 km/h); 60 s at 5/6 ms with the Hertz spring: assets/docs/physics.md §6.
             let limit = 0.01;
             let old = study(Integrator::SemiImplicit);
             for (k, a) in stats(&d).into_iter().enumerate() {

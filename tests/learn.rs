@@ -453,7 +453,7 @@ fn the_burn_engine_without_burn_says_how_to_build_it() {
     assert!(err.contains("--features burn"), "{err}");
 }
 
-/// Quantile heads learn a noise that depends on the inputs (issue 36): on a planted problem
+/// Quantile heads learn a noise that depends on the inputs: on a planted problem
 /// `y = 1000·a + σ·ε` with σ four times larger where the slow input `b` is positive, the
 /// heads' interval is wider there by about that factor (measured 3.1×), and the raw 90 %
 /// quantile interval covers close to 90 % of held-out windows (measured 91.3 %) before any

@@ -1,4 +1,4 @@
-//! Every input file parses or says why, never panics (issue 19): valid files are mutated —
+//! Every input file parses or says why, never panics: valid files are mutated —
 //! truncated, bytes flipped, numbers replaced by NaN, ±inf, huge and negative values or a
 //! string, lines deleted or duplicated (duplicate keys) — and each loader must return either
 //! a value or an error that names the file; a panic fails the test. A bounded number of cases
@@ -379,7 +379,7 @@ fn model_and_data_set_files_parse_or_say_why() {
 
 /// A run cut short, or with a row of other length, is refused in every run format, naming the
 /// file and the row or column: `view` and `assess` index any column by row and panicked on a
-/// CSV truncated inside its last row (issue 34).
+/// CSV truncated inside its last row.
 #[test]
 fn run_files_cut_short_are_refused_in_every_format() {
     use railforce::dataset::read_table;
@@ -509,7 +509,7 @@ fn one_point_and_misplaced_attachments_are_refused() {
 }
 
 /// A data set whose manifest names an unknown noise reference is refused naming the field; it
-/// used to fall back to the default silently (issue 34). Without the field (older data sets)
+/// used to fall back to the default silently . Without the field (older data sets)
 /// the rms reference they were made with is read.
 #[test]
 fn an_unknown_noise_reference_in_a_manifest_is_refused() {
@@ -529,7 +529,7 @@ fn an_unknown_noise_reference_in_a_manifest_is_refused() {
         .replace("curve_r400_v60_seed1.npz", "r.csv")
         .replace("curve_r400_v60_seed4.npz", "r.csv")
     };
-    let today = fixture("2026-12-02.json");
+    let today = fixture("format4.json");
     assert!(today.contains(r#""snr_reference": "std""#));
     std::fs::write(
         dir.join("manifest.json"),
@@ -541,7 +541,11 @@ fn an_unknown_noise_reference_in_a_manifest_is_refused() {
         e.contains("manifest.json") && e.contains("snr_reference") && e.contains("std or rms"),
         "{e}"
     );
-    std::fs::write(dir.join("manifest.json"), fixture("2026-11-22.json")).unwrap();
+    std::fs::write(
+        dir.join("manifest.json"),
+        fixture("format1-first-writer.json"),
+    )
+    .unwrap();
     let ds = DataSet::load(&dir).unwrap();
     assert_eq!(
         ds.noise.map(|n| n.reference),

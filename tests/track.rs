@@ -1,4 +1,4 @@
-//! Track geometry and irregularity checks (issue: foundation and track).
+//! Track geometry and irregularity checks.
 
 use railforce::track::{
     Channel, FraClass, IrregularitySpec, Section, SectionKind, Track, TrackSpec, check,
@@ -474,7 +474,7 @@ fn sections_are_contiguous_from_zero() {
     ));
 }
 
-/// Issue 17: the synthesised gauge never leaves its class's limits (49 CFR 213.53: never
+/// The synthesised gauge never leaves its class's limits (49 CFR 213.53: never
 /// narrower than 4 ft 8 in, −12.7 mm), sampled finely between the grid points too, while the
 /// rest of the signal keeps its PSD level.
 #[test]

@@ -1,4 +1,4 @@
-//! Wagons and tracks that vary (`[vary]` in plan files, issue 36): a drawn value reaches the
+//! Wagons and tracks that vary (`[vary]` in plan files): a drawn value reaches the
 //! simulation, the same seed draws the same wagon, no two runs share a draw, bad keys and
 //! ranges are refused naming the plan key, and a varied data set is the same bytes twice.
 
@@ -82,8 +82,8 @@ fn a_heavier_draw_raises_the_static_wheel_load_by_its_share() {
 
 /// The displacement gauges read from each element's unloaded state, so they see the load: at
 /// rest a pad's vertical gauge reads its static compression, and +10 t on the carbody raises
-/// it by the pad's share over its stiffness, 12.26 kN / k_z, within 2 % (issue 36: a gauge
-/// zeroed on the loaded wagon could not tell a part-loaded one).
+/// it by the pad's share over its stiffness, 12.26 kN / k_z, within 2 % (a gauge zeroed on
+/// the loaded wagon could not tell a part-loaded one).
 #[test]
 fn a_heavier_draw_compresses_every_pad_gauge_by_its_share() {
     use railforce::sim::checks::smooth_tangent;
@@ -125,7 +125,7 @@ fn a_heavier_draw_compresses_every_pad_gauge_by_its_share() {
     }
 }
 
-/// The weighed mass (`vehicle_mass_t`, issue 36) is recorded as the drawn wagon's total
+/// The weighed mass (`vehicle_mass_t`) is recorded as the drawn wagon's total
 /// mass, 10 t more for the heavier draw, and no noise model ever touches it (a known number,
 /// not a sensor): the fleet's models may read the payload that no gauge can.
 #[test]

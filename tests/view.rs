@@ -184,8 +184,8 @@ fn a_run_without_the_channels_is_refused_by_name() {
         !out.status.success() && err.contains("not_there.csv: no such run file"),
         "{err}"
     );
-    // A run cut inside its last row is refused naming the row (it used to panic in `view` and
-    // was read short by `assess`).
+    // A run cut inside its last row is refused naming the row (neither a panic in `view` nor a
+    // short read in `assess`).
     let cut = tmp("cut_short.csv");
     std::fs::write(&cut, "time_s,s_m,w1l_force_y\n0,0,1\n0.005,0.1,2\n0.01,0.").unwrap();
     for cmd in ["view", "assess"] {

@@ -1,4 +1,4 @@
-"""The Python package's measurements (assets/docs/python.md, "Measured"), each against its
+"""The Python package's measurements (assets/docs/python.md, "Speed"), each against its
 reference in the same run:
 
     python examples/python/measure.py --cli target/release/railforce --data data/paper34

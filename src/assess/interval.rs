@@ -1,4 +1,4 @@
-//! Acceptance statistics of identified forces with their intervals (issue 36): each statistic
+//! Acceptance statistics of identified forces with their intervals: each statistic
 //! recomputed with every wheel's Y and Q at the bounds of its identified interval, and the
 //! probability that its limit is exceeded.
 //!

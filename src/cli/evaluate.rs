@@ -102,7 +102,9 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
     ev.write_csv(&out, &model.meta.data.targets)?;
     println!("predictions: {}", out.display());
     match ev.coverage() {
-        None => println!("no intervals: the model has no calibration (trained before 2026-12-02)"),
+        None => println!(
+            "no intervals: the model has no calibration (trained by a version without intervals; `railforce calibrate` adds them)"
+        ),
         Some(rows) => {
             let names: Vec<String> = model
                 .meta

@@ -31,6 +31,9 @@ pub enum WhichArg {
     Paper,
     /// All six.
     All,
+    /// Run nothing: rewrite the results snapshot of the finished run in --out into
+    /// --results (and the headline table --readme quotes).
+    Snapshot,
 }
 
 #[derive(Debug, Args)]
@@ -55,7 +58,7 @@ pub struct ExperimentArgs {
     #[arg(long, default_value_t = 6.0)]
     snr_db: f64,
     /// What the SNR is measured against: `std` (each channel's variation, the default) or
-    /// `rms` (offset included, the former definition).
+    /// `rms` (offset included: a constant offset raises the noise level).
     #[arg(long, default_value = "std", value_parser = ["std", "rms"])]
     snr_reference: String,
     /// Training seeds (comma separated) instead of all of the plan's but the last two.
@@ -108,6 +111,16 @@ pub struct ExperimentArgs {
     /// training seed; each member costs one more training). 1 to 32.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=32))]
     mismatch_members: u16,
+    /// Also write the results snapshot here (it is always written to --out/results.md): the
+    /// date, commit, version, protocol, wall time of each part, a headline table and every
+    /// table and figure, from the run's own files; figures are copied beside it under
+    /// results/. The project's is assets/docs/results.md.
+    #[arg(long)]
+    results: Option<PathBuf>,
+    /// Replace the headline table this README quotes (between its results:headline markers)
+    /// with the snapshot's.
+    #[arg(long)]
+    readme: Option<PathBuf>,
     /// Train the networks on the one fixed noisy copy of the inputs instead of drawing new
     /// noise every epoch (the default draws fresh noise at the same SNR; validation and test
     /// keep their fixed noise either way).
@@ -121,14 +134,27 @@ fn run_with(which: &[Which], opts: &ExperimentOptions) -> Result<()> {
         eprintln!("[{:>6.0} s] {line}", t0.elapsed().as_secs_f64())
     })?;
     println!(
-        "report: {} ({:.0} s)",
+        "report: {} ({:.0} s); results: {}",
         index.display(),
-        t0.elapsed().as_secs_f64()
+        t0.elapsed().as_secs_f64(),
+        opts.out.join(experiment::RESULTS_FILE).display()
     );
     Ok(())
 }
 
 pub fn run(args: ExperimentArgs) -> Result<()> {
+    if args.which.iter().any(|w| matches!(w, WhichArg::Snapshot)) {
+        if args.which.len() > 1 {
+            anyhow::bail!("snapshot runs nothing: give it alone");
+        }
+        let dest = args
+            .results
+            .clone()
+            .unwrap_or_else(|| args.out.join(experiment::RESULTS_FILE));
+        let written = experiment::snapshot(&args.out, &dest, args.readme.as_deref())?;
+        println!("results: {}", written.display());
+        return Ok(());
+    }
     let which: Vec<Which> = args
         .which
         .iter()
@@ -140,13 +166,15 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
             WhichArg::Sensors => Which::Sensors,
             WhichArg::Mismatch => Which::Mismatch,
             WhichArg::Paper => Which::Paper,
-            WhichArg::All => Which::All,
+            WhichArg::All | WhichArg::Snapshot => Which::All,
         })
         .collect();
     let mut opts = ExperimentOptions::full(super::builtin::resolve(&args.plan)?, args.out);
     if which.iter().any(|w| w.parts().contains(&Which::Mismatch)) {
         opts.fleet = Some(super::builtin::resolve(&args.fleet)?);
     }
+    opts.results = args.results;
+    opts.readme = args.readme;
     opts.condition = args.condition;
     opts.snr_db = args.snr_db;
     opts.jobs = args.jobs;
@@ -209,6 +237,7 @@ pub fn demo_options(plan: PathBuf, out: PathBuf) -> ExperimentOptions {
             ..TrainOptions::default()
         },
         condition_windows_per_epoch: 8_000,
+        seed_spread: false,
         ..ExperimentOptions::full(plan, out)
     }
 }

@@ -32,8 +32,8 @@ pub struct GenerateArgs {
     #[arg(long, allow_hyphen_values = true)]
     snr_db: Option<f64>,
     /// What the SNR is measured against: `std` (each channel's variation, the default; a
-    /// constant offset such as gravity sets no noise level) or `rms` (offset included, the
-    /// former definition).
+    /// constant offset such as gravity sets no noise level) or `rms` (offset included: a
+    /// constant offset raises the noise level).
     #[arg(long, default_value = "std", value_parser = ["std", "rms"])]
     snr_reference: String,
     /// Settling time of each run, s (not written).

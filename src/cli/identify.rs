@@ -135,7 +135,7 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
     let secs = t0.elapsed().as_secs_f64();
     if out.bands.is_none() {
         eprintln!(
-            "note: {} has no calibration (trained before 2026-12-02): no intervals; retrain to get them",
+            "note: {} has no calibration (trained by a version without intervals): no intervals; `railforce calibrate` adds them",
             args.model.display()
         );
     }

@@ -5,6 +5,7 @@ mod assess;
 mod bench;
 mod builtin;
 mod calibrate;
+mod channels;
 mod contact;
 mod evaluate;
 mod experiment;
@@ -58,6 +59,16 @@ enum Command {
         after_help = "Examples:\n  railforce contact --vehicle c80 --y-mm 6 --yaw-mrad 2\n  railforce contact --vehicle c80 --sweep-y -10:10:0.5 --out sweep.csv"
     )]
     Contact(contact::ContactArgs),
+    /// The channels a run records: every column's name, unit and meaning, in file order.
+    ///
+    /// The recorder's own list for the vehicle: time and track position, the paper's 21
+    /// inputs, every wheel's forces and contact, every body's motion, every suspension
+    /// element's deflection and the wagon's mass. `--markdown` prints the table of
+    /// assets/docs/channels.md.
+    #[command(
+        after_help = "Examples:\n  railforce channels\n  railforce channels --vehicle c80_empty --markdown"
+    )]
+    Channels(channels::ChannelsArgs),
     /// Linear stability against speed: the whole model linearised about its centred
     /// equilibrium on smooth tangent track, eigenvalues (root locus), damping, named modes
     /// and each family's linear critical speed.
@@ -147,10 +158,11 @@ enum Command {
     /// side by side, on-board sensor selection, and wagons the models did not learn
     /// (mismatch: nominal against fleet-trained). Defaults: split by seed (independent test
     /// runs), 6 dB with σ from each channel's std, centre label. Writes tables (Markdown,
-    /// CSV), SVG figures and index.html with the paper's numbers beside ours. The full
-    /// protocol on the paper's 34 conditions (`experiment all --plan paper34`) took 80
-    /// minutes on two cores (simulation a quarter of it, the rest training); results.md lists
-    /// what each part measured and how long it took.
+    /// CSV), SVG figures and index.html with the paper's numbers beside ours. A run of all
+    /// six writes results.md, the snapshot of what it measured (date, commit, protocol, the
+    /// wall time of each part, every table); `experiment snapshot` rewrites it from a
+    /// finished folder. The full protocol on the paper's 34 conditions takes one to two
+    /// hours on two cores, most of it training.
     #[command(
         after_help = "Examples:\n  railforce experiment comparison --plan demo --out experiments --epochs 2 --windows-per-epoch 2000"
     )]
@@ -242,6 +254,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Track(args) => track::run(args),
         Command::Contact(args) => contact::run(args),
+        Command::Channels(args) => channels::run(args),
         Command::Modes(args) => modes::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Generate(args) => generate::run(args),

@@ -40,7 +40,7 @@ pub struct SimulateArgs {
     /// Integrator (default: linearly-implicit-hertz): `linearly-implicit-hertz` (the wheel–rail
     /// damping and the contact's Hertz spring, each wheelset with its rail masses, and the
     /// side frames' pad damping taken implicitly: accurate at 5/6 ms, `railforce bench step`), `linearly-implicit` (the
-    /// damping alone: 0.5 ms, the default until 2026-12-04), `semi-implicit` (explicit in every
+    /// damping alone: 0.5 ms, for data sets made with it), `semi-implicit` (explicit in every
     /// force: 0.2 ms) or `heun` (second order, two force evaluations a step, explicit: a
     /// reference for small steps).
     #[arg(long, value_parser = railforce::sim::Integrator::NAMES)]

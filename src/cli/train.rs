@@ -21,7 +21,7 @@ pub struct DataArgs {
     #[arg(long)]
     pub data: PathBuf,
     /// Selection file from `railforce select` (channels, window, label position). Without it,
-    /// all 21 paper channels, window 20, label at the last step.
+    /// all 21 paper channels, window 20, label at the centre step.
     #[arg(long)]
     pub selection: Option<PathBuf>,
     /// Targets, comma separated: FL (lateral force of the vehicle's label wheel, 1L for the

@@ -223,10 +223,10 @@ fn dynamics(
     Ok(())
 }
 
-/// The fidelity checks of issue 17: anti-alias, high-frequency force content in a tight
-/// curve, convergence in the step, smooth track position, critical speeds.
+/// The fidelity checks: anti-alias, high-frequency force content in a tight curve,
+/// convergence in the step, smooth track position, critical speeds.
 /// Kink-and-coast starts where the loaded wagon's hunting, once kicked, is a limit cycle: from
-/// 150 km/h at 1 m/s² the kink dies out before the cycle forms (measured 2026-11-27).
+/// 150 km/h at 1 m/s² the kink dies out before the cycle forms (measured).
 const COAST_FROM_KMH: f64 = 200.0;
 
 fn fidelity(
@@ -290,7 +290,7 @@ fn fidelity(
         "tracks/tangent.toml",
     ))?)?;
     let e = railforce::vehicle::Vehicle::load(&super::builtin::resolve(empty)?)?;
-    // The side frames hang on their pads (issue 33): their roll relative to the track, class 5.
+    // The side frames hang on their pads: their roll relative to the track, class 5.
     for (track, kmh) in [
         ("tracks/tangent.toml", 80.0),
         ("tracks/curve_r400.toml", 60.0),
@@ -401,7 +401,7 @@ fn fidelity(
         }
         // The least damped mode (friction stuck, as the describing function finds it at a few
         // mm) against the limit cycle near the critical speed: judged for the loaded wagon on
-        // the files' pair (issue 35's 10 %), reported elsewhere.
+        // the files' pair (within 10 %), reported elsewhere.
         for (k, r) in rows.iter().enumerate() {
             let Some(lin) = r.stuck.as_ref().filter(|c| c.speed_kmh.is_some()) else {
                 continue;

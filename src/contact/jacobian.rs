@@ -1,5 +1,5 @@
 //! A patch's force linearised in the wheelset's velocity: the damping the creep forces and the
-//! normal damping put on the wheelset, for the simulator's linearly implicit step (issue 37).
+//! normal damping put on the wheelset, for the simulator's linearly implicit step.
 //!
 //! The creepages are the contact point's velocity over the running speed, so creep acts as a
 //! damper of `c ≈ f/V` on the wheelset's motion (Kalker's coefficients `f = G·a·b·c_ij`): at

@@ -28,7 +28,7 @@ pub struct FileRef {
     pub name: String,
 }
 
-/// How the runs were integrated and filtered (written since 2026-12-01).
+/// How the runs were integrated and filtered (absent in format 1 and 2 manifests).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Integration {
     /// The integrator, in words.
@@ -133,8 +133,8 @@ pub struct RunEntry {
     /// The run's seed (the unit the splits hold out).
     pub seed: u64,
     /// Seed of the run's irregularities and noise, [`super::realisation_seed`] of the
-    /// condition and seed (absent in manifests before 2026-12-03, whose runs drew both from
-    /// `seed` itself).
+    /// condition and seed (absent in manifests of formats 1–4, whose runs drew both
+    /// from `seed` itself).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub realisation_seed: Option<u64>,
     /// Run file, relative to the data set's folder.
@@ -156,7 +156,7 @@ pub struct RunEntry {
     /// Start position along the track, m.
     #[serde(default)]
     pub start_m: Option<f64>,
-    /// Rows written. (Manifests before 2026-12-02 also held each run's wall time, read and
+    /// Rows written. (Format 3 manifests also held each run's wall time, read and
     /// dropped: a manifest holds only what shapes the data, so one plan gives one manifest's
     /// bytes whether one process, shards or workers made it.)
     pub rows: usize,
@@ -183,7 +183,7 @@ pub struct Manifest {
     pub format: String,
     /// Output sampling rate, Hz.
     pub sampling_rate_hz: f64,
-    /// How the runs were made (absent before 2026-12-01).
+    /// How the runs were made (absent in format 1 and 2 manifests).
     #[serde(default)]
     pub integration: Option<Integration>,
     /// The plan's `[dataset]` options (absent in older manifests: the defaults).
@@ -354,7 +354,8 @@ pub(super) fn run_key(
             opts.stepping.dt
         );
     }
-    // Since 2026-12-03 each condition draws its own realisation: old keys no longer match.
+    // Each condition draws its own realisation: keys of runs that drew it from the seed alone
+    // (formats 1–4) no longer match.
     extra += &format!("|realisation={}", run.realisation_seed());
     fnv1a(
         format!(
@@ -422,8 +423,8 @@ pub(super) fn refuse_mixing(
             json(dataset)
         ));
     }
-    // A run's key names its stepping only when it is not the default, and the default has
-    // changed (0.5 ms linearly implicit until 2026-12-04 evening): the manifest says how its
+    // A run's key names its stepping only when it is not the default, and defaults can
+    // change between versions: the manifest says how its
     // runs were integrated, so a data set never resumes at another step or integrator.
     if let Some(had) = &m.integration {
         let now = Integration::of(opts);

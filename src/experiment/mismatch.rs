@@ -1,4 +1,4 @@
-//! Beyond the paper (issue 36; assets/docs/learning.md §4.6): a wagon the model did not learn.
+//! Beyond the paper (assets/docs/learning.md §4.6): a wagon the model did not learn.
 //! The CNN-BiLSTM trained on the nominal wagon (the generalisation and sensors experiments'
 //! models, reused when they ran) and the same network trained on a fleet (domain
 //! randomisation: every training run draws its own wagon and track from the fleet plan's
@@ -498,7 +498,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                     .collect::<Vec<_>>()
                     .join("; ")
             ),
-            format!("Every model here reads windows of {} steps (the other parts' {}; by default 40: on wagons they did not learn, 0.2 s read FL better than the paper's 0.1 s, assets/docs/results.md, \"FL on held-out wagons\").", opts.mismatch_window, opts.window),
+            format!("Every model here reads windows of {} steps (the other parts' {}; by default 40: on wagons they did not learn, 0.2 s read FL better than the paper's 0.1 s, as CHANGELOG.md records).", opts.mismatch_window, opts.window),
             format!("Trained on the nominal wagon: the generalisation (paper's 21) and sensors (on-board selection) experiments' CNN-BiLSTMs where they ran in the same invocation with the same window, or earlier into the same folder on the same data and protocol. Trained on the fleet (domain randomisation): the same network, inputs and noise; validated and tested on the nominal split's seeds, trained on every other seed of the fleet plan (more wagons where the fleet plan draws more seeds); and once more with the vehicle's weighed mass (`vehicle_mass_t`, a constant of each run that the weighbridge ticket gives) beside each input set (the paper's 21 carry no load channel, so without it the payload's share of the wheel load is invisible to them), {ens}. Every model is calibrated by split conformal on its own validation runs: \"covered\" is the share of true forces inside its 90 % interval, \"flagged\" the share of windows with an input beyond its training envelope (the rule `identify` warns by), and the RMSE where flagged against where quiet says whether the flag fires where the error is large.", ens = match opts.mismatch_members { 1 => "one network each".to_string(), n => format!("each an ensemble of {n} networks from consecutive training seeds, with their quantile heads: the members' mean, and as spread their disagreement and their heads' σ together (total variance)") }),
             ctx.protocol_windowed(&ctx.split, Some(opts.snr_db), opts.mismatch_window),
             format!(

@@ -18,6 +18,11 @@ mod paper;
 mod protocols;
 mod robustness;
 mod sensors;
+mod snapshot;
+pub use snapshot::{
+    HEADLINE_BEGIN, HEADLINE_END, headline_block, quoted_headline, requote, utc_date_time,
+    write_snapshot,
+};
 
 use crate::dataset::DataSet;
 use crate::dataset::{Format, GenerateOptions, generate};
@@ -131,13 +136,13 @@ pub struct ExperimentOptions {
     pub window: usize,
     /// Window length of the mismatch experiment's models, steps (40 = 0.2 s by default: on
     /// held-out wagons the paper's 21 + mass gave FL R² 0.913 at 20 steps and 0.922–0.936 at
-    /// 40, results.md "FL on held-out wagons"). Its nominal models are trained again when it
+    /// 40, measured as CHANGELOG.md records). Its nominal models are trained again when it
     /// differs from `window`.
     pub mismatch_window: usize,
     /// Members of the mismatch experiment's fleet-trained models with the weighed mass (the
     /// deployable ones): networks from seeds seed, seed + 1, … each with its quantile heads,
     /// joined into one ensemble (2 by default: one network's FL R² on held-out wagons moved by
-    /// 0.026 with its training seed, results.md "An ensemble of two for the fleet").
+    /// 0.026 with its training seed, as CHANGELOG.md records).
     pub mismatch_members: usize,
     /// Networks trained at an SNR (matched protocol) draw new training-input noise every
     /// epoch instead of learning one fixed realisation (validation and test keep theirs).
@@ -148,6 +153,29 @@ pub struct ExperimentOptions {
     /// The fleet of the mismatch experiment: a plan whose conditions (by name) give each of
     /// the plan's conditions its `[vary]` (the built-in `paper34_varied` for paper34).
     pub fleet: Option<PathBuf>,
+    /// Train the generalisation's CNN-BiLSTM from a second seed too, so its pooled R² is
+    /// stated with its spread over seeds (the full protocol; the demo leaves it out).
+    pub seed_spread: bool,
+    /// Where to write the results snapshot besides `out/results.md`.
+    pub results: Option<PathBuf>,
+    /// A README whose quoted headline table is replaced by the snapshot's.
+    pub readme: Option<PathBuf>,
+}
+
+/// The results snapshot every run writes into its folder.
+pub const RESULTS_FILE: &str = "results.md";
+
+/// Writes the snapshot of the finished run in `out` to `dest` and, with `readme`, replaces
+/// the headline table that README quotes; returns `dest`.
+pub fn snapshot(out: &Path, dest: &Path, readme: Option<&Path>) -> Result<PathBuf> {
+    let written = write_snapshot(out, dest)?;
+    if let Some(readme) = readme {
+        let snap = crate::io::read_text(&written)?;
+        let text = crate::io::read_text(readme)?;
+        let new = requote(&text, &snap, readme)?;
+        crate::io::write_atomic(readme, |w| w.write_all(new.as_bytes()))?;
+    }
+    Ok(written)
 }
 
 impl ExperimentOptions {
@@ -174,8 +202,8 @@ impl ExperimentOptions {
                 patience: 10,
                 windows_per_epoch: Some(50_000),
                 val_windows: Some(40_000),
-                // Reduce-on-plateau: measured on the fleet (results.md, "The training
-                // schedule on the fleet"): +0.012 FL R² for the paper's 21 + mass.
+                // Reduce-on-plateau: measured on the fleet (CHANGELOG.md): +0.012 FL R²
+                // for the paper's 21 + mass.
                 lr_plateau: 4,
                 ..TrainOptions::default()
             },
@@ -188,6 +216,9 @@ impl ExperimentOptions {
             fresh_noise: true,
             split: None,
             fleet: None,
+            seed_spread: true,
+            results: None,
+            readme: None,
         }
     }
 
@@ -522,5 +553,12 @@ pub fn run(
     let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");
     crate::io::write_atomic(&opts.out.join("meta.json"), |w| w.write_all(mj.as_bytes()))?;
     write_report(&opts.out)?;
+    // The snapshot of what this folder holds: only a run of every part is a whole one.
+    if parts.len() == Which::FOLDERS.len() {
+        write_snapshot(&opts.out, &opts.out.join(RESULTS_FILE))?;
+        if let Some(dest) = &opts.results {
+            snapshot(&opts.out, dest, opts.readme.as_deref())?;
+        }
+    }
     Ok(opts.out.join("index.html"))
 }

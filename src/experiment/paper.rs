@@ -1,4 +1,4 @@
-//! The paper's reported numbers (assets/docs/conditions.md), shown beside ours. They come from a
+//! The paper's reported numbers (the paper's tables, as quoted here), shown beside ours. They come from a
 //! different simulator and unknown splits: a bar to clear, not values to reproduce.
 
 /// Table 2–3: (model, lateral train MSE, R², lateral test MSE, R², vertical train MSE, R²,

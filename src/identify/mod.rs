@@ -341,7 +341,7 @@ impl OutOfDistribution {
 }
 
 /// The out-of-distribution check of a whole recording against the model's training envelope
-/// (`None` for a model without one: trained before 2026-12-02).
+/// (`None` for a model without one).
 pub fn out_of_distribution(model: &Model, input: &CheckedInput) -> Option<OutOfDistribution> {
     let cal = model.meta.calibration.as_ref()?;
     if cal.envelope.is_empty() {
@@ -371,7 +371,7 @@ pub struct Bands {
 }
 
 /// [`identify`], and with `coverage` the interval around every estimate where the model is
-/// calibrated (`None` where it is not: models trained before 2026-12-02).
+/// calibrated (`None` where it is not).
 pub fn identify_with_bands(
     model: &mut Model,
     input: &CheckedInput,

@@ -109,7 +109,7 @@ pub struct ModelMeta {
     #[serde(default = "one", skip_serializing_if = "is_one")]
     pub members: usize,
     /// Conformal calibration on the validation part (`learn::uncertainty`); absent in models
-    /// trained before 2026-12-02.
+    /// written by versions without intervals (they identify without bands).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub calibration: Option<super::calibration::Calibration>,
 }

@@ -1,4 +1,4 @@
-//! Calibrated uncertainty of identified forces (issue 36): a deep ensemble (N networks from
+//! Calibrated uncertainty of identified forces: a deep ensemble (N networks from
 //! different seeds, Lakshminarayanan et al. 2017) whose spread says where the members disagree,
 //! and split conformal prediction (Vovk et al. 2005; Lei et al. 2018) on the validation part's
 //! whole runs, which turns residuals into intervals with a stated coverage.

@@ -1,9 +1,9 @@
 //! The one sensor-noise model (assets/docs/learning.md §1.4): additive white Gaussian noise per input
 //! channel, `σ_c = ref_c · 10^(−SNR/20)`, where `ref_c` is the channel's standard deviation
-//! over the run (its variation, the default) or its root mean square (offset included, the
-//! former definition, kept as an option). Seeded from the run's seed and the channel's name,
-//! so a channel's noise does not depend on which other channels are noised. Labels are never
-//! noised.
+//! over the run (its variation, the default) or its root mean square (offset included, an
+//! option: a constant offset then raises the noise level). Seeded from the run's seed and the
+//! channel's name, so a channel's noise does not depend on which other channels are noised.
+//! Labels are never noised.
 
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
@@ -18,7 +18,7 @@ pub enum SnrReference {
     /// an accelerometer carries no information and does not set the noise level).
     #[default]
     Std,
-    /// The channel's root mean square, offset included (the former definition).
+    /// The channel's root mean square, offset included (a constant offset raises the noise).
     Rms,
 }
 
@@ -140,7 +140,7 @@ mod tests {
         for ((a, b), c) in y2.iter().zip(&shifted).zip(&e) {
             assert!((a - b - c).abs() < 1e-9);
         }
-        // The former definition does depend on the offset.
+        // The rms reference does depend on the offset.
         let r = NoiseModel::new(6.0, SnrReference::Rms);
         assert!(r.sigma(&shifted) > 3.0 * r.sigma(&x));
         // Seeded by run and channel; the noisy name noises like its clean channel.

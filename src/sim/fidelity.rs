@@ -1,5 +1,5 @@
-//! Checks of the simulator's fidelity beyond the closed forms of [`super::checks`] (issues 17,
-//! 33): the critical speed by kink-and-coast and by run-down, the motion left long after a kink
+//! Checks of the simulator's fidelity beyond the closed forms of [`super::checks`]: the
+//! critical speed by kink-and-coast and by run-down, the motion left long after a kink
 //! at constant speed, the side frames' roll, the high-frequency content of the wheel forces in a
 //! tight curve, convergence in the step, the anti-alias filter at the output's Nyquist
 //! frequency and the smoothness of the recorded track position.
@@ -414,8 +414,8 @@ pub fn yq_and_q(rec: &Recording, wheels: usize) -> Result<Vec<(f64, f64)>> {
         .collect()
 }
 
-/// How one integration step compares with a finer one on the same run (issue 37's "same
-/// physics"): the largest relative difference over the wheels of each statistic.
+/// How one integration step compares with a finer one on the same run (whether a coarser step
+/// gives the same physics): the largest relative difference over the wheels of each statistic.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepDifference {
     /// Largest |rms(Y/Q) / rms(Y/Q)_ref − 1| over the wheels.
@@ -553,7 +553,8 @@ mod tests {
     use super::*;
 
     /// The cycle's frequency is read where it last held its amplitude, not in its collapse (the
-    /// loaded C80's run-down, 2026-12-02: 6.82 → 5.63 → 2.85 mm).
+    /// loaded C80's run-down, where the cycle's amplitude falls 6.82 → 5.63 → 2.85 mm as it
+    /// collapses).
     #[test]
     fn cycle_frequency_is_read_where_the_cycle_holds() {
         let kmh = |v: f64| v / 3.6;

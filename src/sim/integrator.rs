@@ -1,5 +1,5 @@
 //! One step of the bodies' motion: semi-implicit Euler with the wheel–rail damping taken
-//! implicitly (linearly implicit, issue 37), the same with the contact's Hertz spring taken in
+//! implicitly (linearly implicit), the same with the contact's Hertz spring taken in
 //! too (linearly implicit Hertz), plain semi-implicit Euler, or Heun's method.
 //!
 //! Creep acts on a wheelset as a damper of `c ≈ f/V` (Kalker's coefficients over the speed):
@@ -20,8 +20,9 @@
 //! (backward Euler on the rail mass on the Hertz spring, about 400 Hz) it took that mode's
 //! energy out every step, a first-order error of 0.64 / 1.31 / 2.56 % in the trailing wheels'
 //! Y/Q rms at 0.1 / 0.2 / 0.4 ms (R 400 m, 80 km/h; 0.22 % at 0.4 ms explicit). Explicit, it
-//! sets the step's limit: ω·Δt < 2 with ω = √((k_H + k_s)/m_rail) ≈ 2 500 rad/s, 0.79 ms
-//! (runs at 0.8 ms diverge, measured).
+//! sets the step's limit: ω·Δt < 2 with ω = √((k_H + k_s)/m_rail) (an estimate: the wheel and rail
+//! masses on the Hertz spring, about 2 990 rad/s, `railforce modes`), which with the side
+//! frames on their pads keeps an explicit step below 0.8 ms (runs at 0.8 ms diverge, measured).
 //!
 //! The contact's Hertz spring and the gyroscopic moment in the solve
 //! (`linearly-implicit-hertz`, the default): [`super::wheelset_solve`]. The same integrator
@@ -51,11 +52,12 @@ use nalgebra::{Matrix3, Matrix6, SMatrix, UnitQuaternion, Vector2, Vector3, Vect
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Integrator {
     /// Semi-implicit (symplectic) Euler: velocities first, positions with the new velocities
-    /// (the default until 2026-12-04, at 0.2 ms).
+    /// (0.2 ms on its own; at 0.05 ms, the reference the implicit steps are measured against).
     SemiImplicit,
     /// Semi-implicit Euler with each wheelset's velocity change, and its rail masses', taken
     /// implicitly in the linearised wheel–rail damping (creep and normal), the contact's Hertz
-    /// spring explicit: the default until 2026-12-04 (late), at 0.5 ms.
+    /// spring explicit, at 0.5 ms: for data sets made with it (their manifest names it) and as
+    /// the Hertz variant without its additions.
     LinearlyImplicit,
     /// The linearly implicit step with the contact's Hertz spring in the solve too (`α·Δt²·K`,
     /// α = 0.15: no numerical damping, the wheel–rail mode's frequency 10 % low at the step),
@@ -92,7 +94,7 @@ impl Integrator {
 
     /// The step a run takes with it when none is given, s: the largest whose statistics stay
     /// within 1 % of the semi-implicit step at 0.05 ms on every paper34 condition (`bench
-    /// step`; README, "Speed"), and a whole number of steps per 200 Hz output sample.
+    /// step`), and a whole number of steps per 200 Hz output sample.
     pub fn default_step(self) -> f64 {
         match self {
             Integrator::SemiImplicit | Integrator::Heun => 2e-4,

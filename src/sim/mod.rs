@@ -9,11 +9,12 @@
 //! states and the track (curvature, cant, gradient, irregularities under each wheel). Signals
 //! are low-pass filtered at the integration rate and decimated to the output rate.
 //!
-//! Why not rapier: the brief's measurement puts rapier3d-f64 0.36 at ≈ 7 µs per step for 15
-//! bodies without colliders — above the whole 5 µs per step that 20× real time allows at the
+//! Why not rapier: the brief's measurement puts rapier3d-f64 0.36 at 7.08 µs per step for the
+//! same 11 bodies without colliders (assets/docs/performance.md) — above the whole 5 µs per step that 20× real time allows at the
 //! 0.1–0.2 ms step the creep forces need — and every force here is computed by the project;
 //! a direct integrator over 11 bodies costs well under a microsecond.
 
+pub mod channels;
 pub mod checks;
 mod element_solve;
 pub mod fidelity;

@@ -9,9 +9,9 @@
 //!
 //! [`Accelerometers`]: crate::vehicle::Accelerometers
 
+use super::Simulation;
 use super::filter::Lowpass;
 use super::profile::StepProfile;
-use super::{Simulation, wheel_name};
 use crate::error::{Error, Result};
 use crate::sensors::{PAPER_CHANNELS, PAPER_UNITS};
 use crate::vehicle::Accelerometers;
@@ -22,29 +22,7 @@ use std::time::Instant;
 
 pub use crate::sensors::VEHICLE_MASS;
 
-const BODY_SIGNALS: [(&str, &str); 10] = [
-    ("acc_x", "m/s2"),
-    ("acc_y", "m/s2"),
-    ("acc_z", "m/s2"),
-    ("roll_rate", "rad/s"),
-    ("pitch_rate", "rad/s"),
-    ("yaw_rate", "rad/s"),
-    ("y_rel", "m"),
-    ("z_rel", "m"),
-    ("roll", "rad"),
-    ("yaw", "rad"),
-];
-
-// Per-wheel creepages are named xi_* so they never clash with the paper's w1l_creep_* inputs.
-const WHEEL_SIGNALS: [(&str, &str); 7] = [
-    ("force_y", "N"),
-    ("force_z", "N"),
-    ("normal", "N"),
-    ("angle", "rad"),
-    ("xi_x", "1"),
-    ("xi_y", "1"),
-    ("xi_spin", "1/m"),
-];
+use super::channels::{BODY_SIGNALS, WHEEL_SIGNALS};
 
 /// Filters and decimates the signals of a simulation.
 pub struct Recorder {
@@ -66,34 +44,11 @@ impl Recorder {
     /// Channels for this simulation's vehicle.
     pub fn new(sim: &Simulation) -> Self {
         let v = sim.vehicle();
-        let mut names: Vec<String> = vec!["time_s".into(), "s_m".into()];
-        let mut units = vec!["s", "m"];
         let paper = v.sensors.is_some();
-        if paper {
-            names.extend(PAPER_CHANNELS.iter().map(|s| s.to_string()));
-            units.extend(PAPER_UNITS);
-        }
-        for k in 0..2 * v.contact.wheelsets.len() {
-            let w = wheel_name(k).to_ascii_lowercase();
-            for (s, u) in WHEEL_SIGNALS {
-                names.push(format!("w{w}_{s}"));
-                units.push(u);
-            }
-        }
-        for b in &v.bodies {
-            for (s, u) in BODY_SIGNALS {
-                names.push(format!("{}_{s}", b.name));
-                units.push(u);
-            }
-        }
-        for e in &v.elements {
-            for (name, _) in e.gauges(&v.bodies) {
-                names.push(name);
-                units.push("m");
-            }
-        }
-        names.push(VEHICLE_MASS.into());
-        units.push("t");
+        let (names, units): (Vec<String>, Vec<&'static str>) = super::channels::channels(v)
+            .into_iter()
+            .map(|c| (c.name, c.unit))
+            .unzip();
         let cfg = sim.config();
         let every = (1.0 / (cfg.output_rate * cfg.dt)).round().max(1.0) as usize;
         let n = names.len();
@@ -358,7 +313,7 @@ impl Recording {
 }
 
 /// Runs a simulation: settles, then records `duration` seconds in memory (about 0.3 MB per
-/// simulated second for the C80's 189 channels). `progress` receives the fraction done.
+/// simulated second for the C80's 228 columns). `progress` receives the fraction done.
 pub fn record(sim: &mut Simulation, mut progress: impl FnMut(f64)) -> Result<Recording> {
     let t0 = std::time::Instant::now();
     sim.settle()?;
@@ -495,10 +450,10 @@ pub fn unit_of(name: &str) -> Option<&'static str> {
         && n.as_bytes()[1].is_ascii_digit()
         && matches!(n.as_bytes()[2], b'l' | b'r')
         && n.as_bytes()[3] == b'_';
-    if wheel && let Some((_, u)) = WHEEL_SIGNALS.iter().find(|(s, _)| &n[4..] == *s) {
+    if wheel && let Some((_, u, _)) = WHEEL_SIGNALS.iter().find(|(s, _, _)| &n[4..] == *s) {
         return Some(u);
     }
-    if let Some((_, u)) = BODY_SIGNALS.iter().find(|(s, _)| {
+    if let Some((_, u, _)) = BODY_SIGNALS.iter().find(|(s, _, _)| {
         n.len() > s.len() + 1 && n.ends_with(s) && n.as_bytes()[n.len() - s.len() - 1] == b'_'
     }) {
         return Some(u);

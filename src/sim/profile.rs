@@ -1,4 +1,4 @@
-//! Where a step's time goes (issue 37): a simulation with profiling on times each part of its
+//! Where a step's time goes: a simulation with profiling on times each part of its
 //! step — every force element by kind, the track frames, the track springs, the contact
 //! (wheel placement and the patch solve apart), the rails, the hauling, the integration and
 //! the checks — with the clock read around each part. Off by default: the step then pays one

@@ -4,7 +4,7 @@
 //! [`super::integrator`]'s).
 //!
 //! The contact's Hertz spring in the solve (`linearly-implicit-hertz`): explicit, the wheel and
-//! its rail mass on the spring between them (about 2 840 rad/s) limit the step to ω·Δt < 2, and
+//! its rail mass on the spring between them (about 2 990 rad/s, 476 Hz, `railforce modes`) limit the step to ω·Δt < 2, and
 //! the statistics fall off a cliff above 0.6 ms (28–38 % off at 5/7 ms, R 400 m at 100 km/h).
 //! Taking `α·Δt²·K` into the solve beside `θ·Δt·D` (`K` the patches' normal stiffness at their
 //! load centres, [`crate::contact::patch_stiffness`]) makes a linear spring's step
@@ -130,7 +130,7 @@ pub(super) const THETA: f64 = 0.5;
 /// 100 km/h (Q's standard deviation 105 % off); α = 0.12 (limit 2.77, a peak of 2.6 times)
 /// held it within 0.38 % but burst on R 400 m at 80 km/h (1.35 % off); α = 0.15 (limit 3.16,
 /// a peak of 5.6 times) puts the wheel–rail mode 10 % low (about 430 Hz for 476 Hz, far
-/// above the recorded band) and every paper34 condition within 1 % (README, "Speed"). Fox and
+/// above the recorded band) and every paper34 condition within 1 %. Fox and
 /// Goodwin's 1/12 (the frequency right to fourth order, limit 2.45) left four paper34
 /// conditions 1.0–1.7 % off in Q's standard deviation already at 5/7 ms.
 pub(super) const ALPHA: f64 = 0.15;
@@ -362,8 +362,8 @@ mod tests {
         );
     }
 
-    /// The contact's Hertz spring in the solve against the closed form (issue 37's stiff
-    /// spring–mass at the new step): a wheelset on two free rail masses (250 kg each) on
+    /// The contact's Hertz spring in the solve against the closed form (the stiff spring–mass
+    /// the default step must carry): a wheelset on two free rail masses (250 kg each) on
     /// vertical springs of 1.5 GN/m at its wheels, their relative mode at ω = 2 880 rad/s, so
     /// ω·Δt = 2.40 at the default 5/6 ms, past the explicit step's limit of 2. With the share α the step is
     /// symplectic Euler on `Ω² = ω²/(1 + α·ω²·Δt²)`: its period is `2π·Δt / (2·asin(Ω·Δt/2))`

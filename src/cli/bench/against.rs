@@ -9,8 +9,8 @@ use std::process::Command;
 
 /// The real-time factors that a `bench simulate` printed, physics only and with all channels
 /// (the lines `physics only: … X× real time` and `with all channels: … Y× real time …`, which
-/// every railforce since 2026-11 prints). Real time, not µs per step: the two binaries may
-/// step at different steps (their own defaults).
+/// the other binary must print too; one without them is refused). Real time, not µs per step:
+/// the two binaries may step at different steps (their own defaults).
 fn parse(stdout: &str) -> Option<(f64, f64)> {
     let number = |key: &str| -> Option<f64> {
         let line = stdout.lines().find(|l| l.trim_start().starts_with(key))?;

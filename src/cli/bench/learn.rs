@@ -1,5 +1,5 @@
 //! Training and inference throughput of the networks (windows per second, one thread), with
-//! the spec's PyTorch reference figures (assets/docs/learning.md §5) and this machine's sustained GEMM rate
+//! the spec's PyTorch reference figures (assets/docs/performance.md, "Learning engine") and this machine's sustained GEMM rate
 //! measured in the same run (the hardware reference the ratio is read against).
 
 use railforce::learn::linalg::gemm;
@@ -16,7 +16,7 @@ pub struct NetBench {
     pub infer_windows_per_s: f64,
     /// Inference latency of one window, ms.
     pub single_ms: f64,
-    /// PyTorch 2.15 CPU one-thread training reference (assets/docs/learning.md §5), windows/s.
+    /// PyTorch 2.15 CPU one-thread training reference (assets/docs/performance.md, "Learning engine"), windows/s.
     pub pytorch_train_reference: f64,
 }
 
@@ -147,7 +147,7 @@ pub fn burn_table(engines: &[String], batches: &[usize], seconds: f64) -> anyhow
         "train win/s",
         "fused win/s",
         "vs fused",
-        "PyTorch CPU (learning.md §5)"
+        "PyTorch CPU (performance.md)"
     );
     for a in [A::CnnBiLstm, A::Cnn, A::BiLstm, A::Gru] {
         for &batch in batches {

@@ -18,7 +18,7 @@ pub struct BenchArgs {
 #[derive(Debug, Subcommand)]
 enum What {
     /// Training and inference throughput of the four networks (windows/s, one thread, batch
-    /// 64, 21 channels × 20 steps) beside the PyTorch figures of assets/docs/learning.md §5 and this machine's
+    /// 64, 21 channels × 20 steps) beside the PyTorch figures of assets/docs/performance.md ("Learning engine") and this machine's
     /// GEMM rate; then the fit time of XGBoost-style and GBDT boosting on synthetic windows.
     Learn {
         /// Seconds per network figure.
@@ -137,7 +137,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             }
             if let Some(b) = paper_net {
                 println!(
-                    "cnn-bilstm inference vs PyTorch (learning.md §5: {:.0} windows/s batched, {:.2} ms one window): {:.2}× batched, {:.1}× one window",
+                    "cnn-bilstm inference vs PyTorch (performance.md: {:.0} windows/s batched, {:.2} ms one window): {:.2}× batched, {:.1}× one window",
                     learn::PYTORCH_INFER_WINDOWS_PER_S,
                     learn::PYTORCH_SINGLE_MS,
                     b.infer_windows_per_s / learn::PYTORCH_INFER_WINDOWS_PER_S,

@@ -52,7 +52,7 @@ pub struct NetConfig {
     pub channels: usize,
     /// Outputs of the head (1 for FL or FQ, 2 for both; three times that with quantile heads).
     pub outputs: usize,
-    /// Quantile heads (issue 36): with `Some(c)`, the head gives per target its mean, then its
+    /// Quantile heads: with `Some(c)`, the head gives per target its mean, then its
     /// `(1 − c)/2` and `(1 + c)/2` quantiles (`outputs` is three times the targets, in that
     /// order), trained with the pinball loss beside the mean's squared error.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -37,7 +37,7 @@ pub struct TrainOptions {
     /// What computes each minibatch's forward and backward pass (networks only).
     #[serde(default)]
     pub engine: GradientEngine,
-    /// Networks: quantile heads at this nominal coverage beside the mean (issue 36; the
+    /// Networks: quantile heads at this nominal coverage beside the mean (the
     /// intervals then follow the heads' width, `learn::uncertainty`). The default,
     /// [`DEFAULT_QUANTILE_HEADS`]: as well calibrated as a 5-member ensemble for a fifth of
     /// its training time (assets/docs/learning.md §3.1). Where heads cannot apply (classical

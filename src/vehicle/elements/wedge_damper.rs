@@ -54,10 +54,10 @@ pub struct WedgeDamper {
 /// moves by `λ` along the trial force's direction, taken implicitly over the step `dt` (backward
 /// Euler, radial return): `k·(d − s − λ·n) + c·(v − λ·n/dt) = limit·n`, so
 /// `λ = (|trial| − limit)/(k + c/dt)` and the force sits on the limit. With `c = 0` this is the
-/// elasto-plastic return map `s = d − n·limit/k`. Before 2026-12-04 a damped slider was reset
-/// to that same point, dropping the damper's share each step: the slip direction then turned
-/// toward the velocity by `c·|v|/limit` of a radian per step, whatever the step, so the run
-/// depended on the step at first order (issue 37; `bench step`). Works for any dimension.
+/// elasto-plastic return map `s = d − n·limit/k`. A damped slider is not reset to that same
+/// point: that would drop the damper's share each step and turn the slip direction toward the
+/// velocity by `c·|v|/limit` of a radian per step, whatever the step, so the run would depend
+/// on the step at first order (`bench step`). Works for any dimension.
 #[inline]
 pub fn slider<const N: usize>(
     d: &nalgebra::SVector<f64, N>,

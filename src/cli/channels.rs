@@ -1,0 +1,35 @@
+//! `railforce channels`: the columns a run of a vehicle records, as the recorder lists them.
+
+use anyhow::Result;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct ChannelsArgs {
+    /// Vehicle file (or a built-in name: c80, c80_empty).
+    #[arg(long, default_value = "vehicles/c80.toml")]
+    vehicle: PathBuf,
+    /// Print the Markdown table of assets/docs/channels.md (number, name, unit, kind,
+    /// meaning) instead of one `name<TAB>unit<TAB>meaning` line per channel.
+    #[arg(long)]
+    markdown: bool,
+}
+
+pub fn run(args: ChannelsArgs) -> Result<()> {
+    let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&args.vehicle)?)?;
+    let list = railforce::sim::channels::channels(&v);
+    if args.markdown {
+        print!(
+            "{}",
+            railforce::sim::channels::markdown(
+                &list,
+                &railforce::sensors::label_channels(&v.label_wheel_name())
+            )
+        );
+    } else {
+        for c in &list {
+            println!("{}\t{}\t{}", c.name, c.unit, c.meaning);
+        }
+    }
+    Ok(())
+}

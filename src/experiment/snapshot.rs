@@ -1,0 +1,353 @@
+//! The results snapshot: `results.md` written from a finished run's own files (`meta.json`
+//! and each part's `section.json`), so the figures a reader quotes are the ones the run
+//! measured. It carries the date, the commit and the binary's version, every protocol line,
+//! the wall time of each part, a headline table picked from the parts' tables, and every
+//! table and figure of every part. The README quotes the headline table between
+//! [`HEADLINE_BEGIN`] and [`HEADLINE_END`] (a test holds the two equal).
+
+use super::Which;
+use super::index::{protocol_lines, read_json};
+use crate::error::{Error, Result};
+use crate::report::SavedSection;
+use crate::report::table::{MISSING, Table};
+use std::path::{Path, PathBuf};
+
+/// The line before the headline table, in the snapshot and in the README.
+pub const HEADLINE_BEGIN: &str =
+    "<!-- results:headline:begin (written by railforce experiment; do not edit) -->";
+/// The line after it.
+pub const HEADLINE_END: &str = "<!-- results:headline:end -->";
+
+/// Writes the snapshot of the run in `out` to `dest` (atomically), copying the parts'
+/// figures into `dest`'s folder under `results/<part>/` unless `dest` lies in `out`. Refuses
+/// a folder without a finished run (`meta.json` with its wall time).
+pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
+    let meta_path = out.join("meta.json");
+    let meta = read_json(&meta_path).ok_or_else(|| Error::Parse {
+        file: meta_path.clone(),
+        message: "no finished run here (run `railforce experiment all` first)".into(),
+    })?;
+    if meta["wall_seconds"].as_f64().is_none() {
+        return Err(Error::Parse {
+            file: meta_path,
+            message: "the run did not finish (no wall_seconds)".into(),
+        });
+    }
+    let dest_dir = dest
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let same = same_dir(&dest_dir, out);
+    let mut md = String::new();
+    md += "# Results\n\n";
+    md += &format!(
+        "Written by `railforce experiment` from its own tables when the run finished: do not edit; rerun and this file is rewritten (`railforce experiment all --plan {} --out {} --results {}`, or `railforce experiment snapshot --out {} --results {}` for a finished folder). The protocol behind every number: [learning.md](learning.md); the words: [glossary.md](glossary.md).\n\n",
+        meta["plan_name"].as_str().unwrap_or("?"),
+        out.display(),
+        dest.display(),
+        out.display(),
+        dest.display(),
+    );
+    let commit = meta["commit"].as_str().unwrap_or("unknown");
+    md += &format!(
+        "- **Run:** finished {} (UTC), railforce {}, commit `{}`, {} wall time in all.\n",
+        meta["finished_unix"]
+            .as_u64()
+            .map_or("?".into(), utc_date_time),
+        meta["railforce_version"].as_str().unwrap_or("?"),
+        commit,
+        minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0)),
+    );
+    for line in protocol_lines(&meta) {
+        md += &format!("- {}\n", line.trim_start_matches("Latest run: "));
+    }
+    md += "- Paper numbers come from another simulator and an unstated (apparently shuffled) split: a bar, not a target to match digit for digit.\n\n";
+    md += "## Headline\n\n";
+    md += &headline_block(out)?;
+    md += "\n## Wall time of each part\n\n";
+    let mut wt = Table::new(&["part", "wall time"]);
+    for f in Which::FOLDERS {
+        if let Some(s) = meta["timings"][format!("{f}_s")].as_f64() {
+            wt.push(vec![f.to_string(), minutes(s)]);
+        }
+    }
+    wt.push(vec![
+        "all, with the simulation of the data".into(),
+        minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0)),
+    ]);
+    md += &wt.markdown();
+    for f in Which::FOLDERS {
+        let Some(sec) = SavedSection::read(&out.join(f))? else {
+            continue;
+        };
+        md += &format!("\n## {}\n\n", sec.title);
+        for p in &sec.text {
+            md += &format!("{p}\n\n");
+        }
+        for (cap, t, _) in &sec.tables {
+            md += &format!("**{cap}**\n\n{}\n", t.markdown());
+        }
+        for (cap, name) in &sec.figures {
+            let link = if same {
+                format!("{f}/{name}")
+            } else {
+                let rel = format!("results/{f}/{name}");
+                let to = dest_dir.join(&rel);
+                if let Some(d) = to.parent() {
+                    std::fs::create_dir_all(d).map_err(|e| Error::io(d, e))?;
+                }
+                let svg = crate::io::read_text(&out.join(f).join(name))?;
+                crate::io::write_atomic(&to, |w| w.write_all(svg.as_bytes()))?;
+                rel
+            };
+            md += &format!("![{cap}]({link})\n\n*{cap}*\n\n");
+        }
+    }
+    crate::io::write_atomic(dest, |w| w.write_all(md.as_bytes()))?;
+    Ok(dest.to_path_buf())
+}
+
+/// Whether two folders are the same on disk.
+fn same_dir(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// The headline table of the run in `out` between its markers, as the README quotes it.
+pub fn headline_block(out: &Path) -> Result<String> {
+    Ok(format!(
+        "{HEADLINE_BEGIN}\n{}{HEADLINE_END}\n",
+        headline(out)?.markdown()
+    ))
+}
+
+/// The text between the markers (markers included) of a snapshot or README, if any.
+pub fn quoted_headline(text: &str) -> Option<&str> {
+    let a = text.find(HEADLINE_BEGIN)?;
+    let b = text[a..].find(HEADLINE_END)? + a + HEADLINE_END.len();
+    Some(&text[a..b])
+}
+
+/// `readme` with its quoted headline replaced by `snapshot`'s; an error names the file that
+/// lacks the markers.
+pub fn requote(readme: &str, snapshot: &str, readme_path: &Path) -> Result<String> {
+    let new = quoted_headline(snapshot).ok_or_else(|| Error::Parse {
+        file: readme_path.to_path_buf(),
+        message: "the snapshot has no headline table".into(),
+    })?;
+    let old = quoted_headline(readme).ok_or_else(|| Error::Parse {
+        file: readme_path.to_path_buf(),
+        message: format!("no headline markers ({HEADLINE_BEGIN} … {HEADLINE_END})"),
+    })?;
+    Ok(readme.replacen(old, new, 1))
+}
+
+/// The headline: the figures a reader asks first, each row picked from a part's own table.
+fn headline(out: &Path) -> Result<Table> {
+    let mut h = Table::new(&[
+        "what",
+        "FL R²",
+        "FQ R²",
+        "FL RMSE kN",
+        "FQ RMSE kN",
+        "protocol",
+    ]);
+    let tables = |f: &str| -> Result<Vec<(String, Table, String)>> {
+        Ok(SavedSection::read(&out.join(f))?
+            .map(|s| s.tables)
+            .unwrap_or_default())
+    };
+    let find = |ts: &[(String, Table, String)], stem: &str| -> Option<Table> {
+        ts.iter().find(|t| t.2 == stem).map(|t| t.1.clone())
+    };
+    let general = tables("generalization")?;
+    if let Some(t) = find(&general, "seed_spread")
+        && let Some(r) = t.rows.last()
+    {
+        h.push(vec![
+            "Generalisation, the paper's 21, pooled over 34 conditions (two training seeds: mean ± half range)".into(),
+            cell(&t, r, "FL R²"),
+            cell(&t, r, "FQ R²"),
+            cell(&t, r, "FL RMSE kN"),
+            cell(&t, r, "FQ RMSE kN"),
+            "one CNN-BiLSTM, FL and FQ as two outputs, test on seed 4".into(),
+        ]);
+    }
+    if let Some(t) = find(&general, "per_condition") {
+        let rows: Vec<&Vec<String>> = t
+            .rows
+            .iter()
+            .filter(|r| r.first().is_some_and(|c| !c.starts_with("all")))
+            .collect();
+        h.push(vec![
+            "the same model per condition, lowest – highest".into(),
+            range(&t, &rows, "FL R²"),
+            range(&t, &rows, "FQ R²"),
+            MISSING.into(),
+            MISSING.into(),
+            "each condition's own test variance (first seed)".into(),
+        ]);
+    }
+    if let Some(t) = find(&tables("sensors")?, "sensors") {
+        for r in &t.rows {
+            h.push(vec![
+                format!(
+                    "Sensors: {} ({} channels) at {} dB",
+                    cell(&t, r, "inputs"),
+                    cell(&t, r, "channels"),
+                    cell(&t, r, "SNR dB")
+                ),
+                cell(&t, r, "FL R²"),
+                cell(&t, r, "FQ R²"),
+                cell(&t, r, "FL RMSE kN"),
+                cell(&t, r, "FQ RMSE kN"),
+                "CNN-BiLSTM, all conditions, test on seed 4".into(),
+            ]);
+        }
+    }
+    if let Some(t) = find(&tables("protocols")?, "protocols") {
+        for r in &t.rows {
+            h.push(vec![
+                format!("Protocol: {}", cell(&t, r, "protocol")),
+                cell(&t, r, "FL R²"),
+                cell(&t, r, "FQ R²"),
+                cell(&t, r, "FL RMSE kN"),
+                cell(&t, r, "FQ RMSE kN"),
+                cell(&t, r, "what the test part is"),
+            ]);
+        }
+    }
+    let cmp = tables("comparison")?;
+    if let (Some(fl), Some(fq)) = (find(&cmp, "comparison_fl"), find(&cmp, "comparison_fq")) {
+        for r in &fl.rows {
+            let model = cell(&fl, r, "model");
+            let q = fq.rows.iter().find(|q| cell(&fq, q, "model") == model);
+            h.push(vec![
+                format!("Comparison on one condition: {model}"),
+                cell(&fl, r, "test R²"),
+                q.map_or(MISSING.into(), |q| cell(&fq, q, "test R²")),
+                cell(&fl, r, "test RMSE kN"),
+                q.map_or(MISSING.into(), |q| cell(&fq, q, "test RMSE kN")),
+                "one model per target, trained on that condition alone".into(),
+            ]);
+        }
+    }
+    if let Some(t) = find(&tables("robustness")?, "robustness") {
+        for r in &t.rows {
+            let snr: f64 = cell(&t, r, "SNR dB").parse().unwrap_or(f64::NAN);
+            if snr == 1.0 && cell(&t, r, "protocol").starts_with("matched") {
+                h.push(vec![
+                    format!("Robustness at 1 dB: {}", cell(&t, r, "model")),
+                    cell(&t, r, "FL R²"),
+                    cell(&t, r, "FQ R²"),
+                    MISSING.into(),
+                    MISSING.into(),
+                    "one condition, trained and tested at 1 dB".into(),
+                ]);
+            }
+        }
+    }
+    if let Some(t) = find(&tables("mismatch")?, "mismatch") {
+        for r in &t.rows {
+            if cell(&t, r, "tested on") == "fleet" {
+                h.push(vec![
+                    format!(
+                        "Held-out wagons: {}, trained on {}",
+                        cell(&t, r, "inputs"),
+                        cell(&t, r, "trained on")
+                    ),
+                    cell(&t, r, "FL R²"),
+                    cell(&t, r, "FQ R²"),
+                    cell(&t, r, "FL RMSE kN"),
+                    cell(&t, r, "FQ RMSE kN"),
+                    "the fleet's test wagons, never trained on".into(),
+                ]);
+            }
+        }
+    }
+    Ok(h)
+}
+
+/// The cell of row `r` under `column`, or [`MISSING`].
+fn cell(t: &Table, r: &[String], column: &str) -> String {
+    t.header
+        .iter()
+        .position(|c| c == column)
+        .and_then(|i| r.get(i))
+        .cloned()
+        .unwrap_or_else(|| MISSING.into())
+}
+
+/// "lowest – highest" of a numeric column over `rows`.
+fn range(t: &Table, rows: &[&Vec<String>], column: &str) -> String {
+    let v: Vec<f64> = rows
+        .iter()
+        .filter_map(|r| cell(t, r, column).parse::<f64>().ok())
+        .filter(|v| v.is_finite())
+        .collect();
+    if v.is_empty() {
+        return MISSING.into();
+    }
+    let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    format!("{lo:.3} – {hi:.3}")
+}
+
+/// "12.3 min" (or seconds below a minute).
+fn minutes(s: f64) -> String {
+    if s < 60.0 {
+        format!("{s:.0} s")
+    } else {
+        format!("{:.1} min", s / 60.0)
+    }
+}
+
+/// `YYYY-MM-DD HH:MM` of seconds since 1970-01-01 UTC (the civil calendar from the day
+/// count, Howard Hinnant's `civil_from_days`).
+pub fn utc_date_time(unix: u64) -> String {
+    let days = (unix / 86_400) as i64;
+    let secs = unix % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02} {:02}:{:02}",
+        secs / 3_600,
+        (secs % 3_600) / 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_calendar_reads_known_instants() {
+        assert_eq!(utc_date_time(0), "1970-01-01 00:00");
+        // A leap day of a century leap year, at 12:34.
+        assert_eq!(utc_date_time(951_827_640), "2000-02-29 12:34");
+        assert_eq!(utc_date_time(1_796_493_600), "2026-12-05 18:00");
+    }
+
+    #[test]
+    fn the_readme_quote_is_replaced_between_its_markers() {
+        let snap = format!("x\n{HEADLINE_BEGIN}\n| a |\n{HEADLINE_END}\ny");
+        let readme = format!("head\n{HEADLINE_BEGIN}\n| old |\n{HEADLINE_END}\ntail");
+        let new = requote(&readme, &snap, Path::new("README.md")).unwrap();
+        assert_eq!(
+            new,
+            format!("head\n{HEADLINE_BEGIN}\n| a |\n{HEADLINE_END}\ntail")
+        );
+        let err = requote("no markers", &snap, Path::new("README.md")).unwrap_err();
+        assert!(err.to_string().contains("README.md"), "{err}");
+    }
+}
