@@ -34,6 +34,32 @@ where
     })
 }
 
+/// Refuses a CSV text (header line, then rows) with a cell that reads as a non-finite number
+/// (`NaN`, `inf`, `-inf`, any case), naming the file, the column and the row: a table is
+/// checked before it is written, so none carries NaN.
+pub fn check_csv_finite(text: &str, path: &Path) -> Result<()> {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    for (r, line) in lines.enumerate() {
+        for (c, cell) in line.split(',').enumerate() {
+            let t = cell
+                .trim()
+                .trim_start_matches(['+', '-'])
+                .to_ascii_lowercase();
+            if t == "nan" || t == "inf" || t == "infinity" {
+                return Err(Error::Domain(format!(
+                    "{}: not written: column {} holds {} at row {}",
+                    path.display(),
+                    header.get(c).copied().unwrap_or("?"),
+                    cell.trim(),
+                    r + 1
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Temporary sibling of `path` used by [`write_atomic`]: `.NAME.tmp-PID-N`, N unique within
 /// the process so that two threads writing the same file never share a temporary.
 fn temp_path(path: &Path) -> PathBuf {

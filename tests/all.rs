@@ -28,6 +28,8 @@ mod export;
 mod features;
 #[path = "fidelity.rs"]
 mod fidelity;
+#[path = "hardening.rs"]
+mod hardening;
 #[path = "identify.rs"]
 mod identify;
 #[path = "integrator.rs"]

@@ -128,9 +128,11 @@ fn noise_protocols_pick_the_right_columns() {
 #[test]
 fn filter_and_wrapper_find_the_informative_channels() {
     let ds = synthetic(2, 3000);
+    // The planted target depends on its window's last step.
     let opts = SelectOptions {
         target: "FQ".into(),
         mi_threshold: 0.0,
+        label_at: LabelAt::Last,
         ..SelectOptions::default()
     };
     let sel = features::select(&ds, &Split::default(), &opts).unwrap();

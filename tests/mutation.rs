@@ -322,6 +322,28 @@ fn model_and_data_set_files_parse_or_say_why() {
         &[&model.join("model.bin")],
         |p| railforce::learn::model::Model::load(p.parent().unwrap()),
     );
+    // A standard deviation of zero would divide every input into infinities (identify wrote
+    // NaN in every column), a negative one flip its sign: both refused at load, by field.
+    let json = model.join("model.json");
+    let good = std::fs::read_to_string(&json).unwrap();
+    for (field, bad) in [
+        ("input_stats", 0.0),
+        ("input_stats", -1.0),
+        ("target_stats", 0.0),
+    ] {
+        let mut v: serde_json::Value = serde_json::from_str(&good).unwrap();
+        v[field]["std"][0] = serde_json::json!(bad);
+        std::fs::write(&json, serde_json::to_string(&v).unwrap()).unwrap();
+        let err = railforce::learn::model::Model::load(&model)
+            .err()
+            .unwrap_or_else(|| panic!("{field}.std = {bad} was accepted"))
+            .to_string();
+        assert!(
+            err.contains("model.json") && err.contains(&format!("{field}.std")),
+            "{err}"
+        );
+    }
+    std::fs::write(&json, &good).unwrap();
     let files: Vec<PathBuf> = std::fs::read_dir(&data)
         .unwrap()
         .map(|e| e.unwrap().path())

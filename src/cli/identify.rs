@@ -159,6 +159,7 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
         );
     }
     let (spans, reports) = (&out.ood_spans, &out.reports);
+    railforce::io::check_csv_finite(&s, &args.out)?;
     if args.out.as_os_str() == "-" {
         std::io::stdout().write_all(s.as_bytes())?;
     } else {

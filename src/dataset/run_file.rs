@@ -104,6 +104,7 @@ pub(super) fn add_noise(rec: &mut Recording, noise: &NoiseModel, seed: u64) {
 
 /// Writes a recording in a format, atomically.
 pub fn write_run(path: &Path, rec: &Recording, format: Format, float32: bool) -> Result<()> {
+    rec.check_finite(path)?;
     match format {
         Format::Csv => {
             let single: Vec<bool> = rec.names.iter().map(|n| float32 && !keeps_f64(n)).collect();

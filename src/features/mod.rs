@@ -54,10 +54,13 @@ impl Selection {
     /// Reads a selection file written by `railforce select`; errors name the file.
     pub fn load(path: &std::path::Path) -> Result<Self> {
         let text = crate::io::read_text(path)?;
-        serde_json::from_str(&text).map_err(|e| Error::Parse {
+        let s: Self = serde_json::from_str(&text).map_err(|e| Error::Parse {
             file: path.to_path_buf(),
             message: format!("not a selection file: {e}"),
-        })
+        })?;
+        s.input_stats.check(path, "input_stats")?;
+        s.target_stats.check(path, "target_stats")?;
+        Ok(s)
     }
 }
 

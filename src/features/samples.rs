@@ -270,6 +270,43 @@ pub struct ZScore {
 }
 
 impl ZScore {
+    /// Checks statistics read from a file: one mean and one standard deviation per name,
+    /// every mean finite, every standard deviation finite and above zero (a zero would
+    /// divide every input into infinities, a negative flip its sign). The error names the
+    /// file, the field and the channel.
+    pub fn check(&self, file: &std::path::Path, field: &str) -> Result<()> {
+        let n = self.names.len();
+        if self.mean.len() != n || self.std.len() != n {
+            return Err(Error::config(
+                file,
+                field,
+                format!(
+                    "{} names, {} means and {} standard deviations: one of each per channel",
+                    n,
+                    self.mean.len(),
+                    self.std.len()
+                ),
+            ));
+        }
+        for ((name, m), s) in self.names.iter().zip(&self.mean).zip(&self.std) {
+            if !m.is_finite() {
+                return Err(Error::config(
+                    file,
+                    format!("{field}.mean"),
+                    format!("{name}: {m} is not a finite mean"),
+                ));
+            }
+            if !(s.is_finite() && *s > 0.0) {
+                return Err(Error::config(
+                    file,
+                    format!("{field}.std"),
+                    format!("{name}: {s}: a standard deviation must be finite and above zero"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Statistics of `channels` over the training blocks.
     pub fn fit(ds: &DataSet, blocks: &[Block], channels: &[usize]) -> Self {
         let mut mean = vec![0.0; channels.len()];

@@ -242,6 +242,8 @@ impl Model {
                 format!("{} is outside 1..=32", meta.members),
             ));
         }
+        meta.input_stats.check(&path, "input_stats")?;
+        meta.target_stats.check(&path, "target_stats")?;
         let engine = read_engine(dir, &path, &meta, "")?;
         let members = (2..=meta.members)
             .map(|k| read_engine(dir, &path, &meta, &format!("_member{k}")))

@@ -535,23 +535,45 @@ impl<'a> Simulation<'a> {
     /// Non-finite states, runaway motion, derailment.
     fn check(&mut self) -> Result<()> {
         self.step_count += 1;
+        // A non-finite state, every step and before anything looks the track up with it: a
+        // NaN position must end the run with its name, not reach a grid lookup. One sum
+        // carries any NaN or infinity of the state (inf − inf is NaN too).
+        let sum: f64 = self
+            .states
+            .iter()
+            .map(|st| {
+                st.position.sum()
+                    + st.velocity.sum()
+                    + st.angular_velocity.sum()
+                    + st.rotation.coords.sum()
+            })
+            .sum();
+        if !sum.is_finite() {
+            for (i, st) in self.states.iter().enumerate() {
+                let finite = st.position.iter().all(|v| v.is_finite())
+                    && st.velocity.iter().all(|v| v.is_finite())
+                    && st.angular_velocity.iter().all(|v| v.is_finite())
+                    && st.rotation.coords.iter().all(|v| v.is_finite());
+                if !finite {
+                    return Err(Error::Domain(format!(
+                        "simulation diverged at t = {:.4} s: body '{}' has a non-finite state",
+                        self.time, self.vehicle.bodies[i].name
+                    )));
+                }
+            }
+            return Err(Error::Domain(format!(
+                "simulation diverged at t = {:.4} s: the state grew beyond floating point",
+                self.time
+            )));
+        }
         // Whole-state checks every 100 steps (10 ms at the default step); wheels every step.
         let full = self.step_count.is_multiple_of(100);
         if full {
             self.refresh_frames();
         }
         for (i, st) in self.states.iter().enumerate().filter(|_| full) {
-            let finite = st.position.iter().all(|v| v.is_finite())
-                && st.velocity.iter().all(|v| v.is_finite())
-                && st.angular_velocity.iter().all(|v| v.is_finite());
             let rel_v = st.velocity - self.frames[i].axes.column(0) * self.cfg.speed;
             let name = &self.vehicle.bodies[i].name;
-            if !finite {
-                return Err(Error::Domain(format!(
-                    "simulation diverged at t = {:.4} s: body '{name}' has a non-finite state",
-                    self.time
-                )));
-            }
             if rel_v.norm() > self.cfg.runaway_speed {
                 return Err(Error::Domain(format!(
                     "simulation diverged at t = {:.4} s: body '{name}' moves {:.1} m/s away from the running motion (runaway energy)",

@@ -249,7 +249,7 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
 }
 
 /// What a finished run reports.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct RunSummary {
     /// Rows written.
     pub rows: usize,
@@ -284,6 +284,24 @@ impl Recording {
     /// One column by index.
     pub fn column(&self, i: usize) -> Vec<f64> {
         self.rows.iter().map(|r| r[i]).collect()
+    }
+
+    /// Refuses a recording that holds a non-finite value, naming the column, the row and the
+    /// file it was to be written to: no writer puts NaN or infinity in a file.
+    pub fn check_finite(&self, path: &Path) -> Result<()> {
+        for (r, row) in self.rows.iter().enumerate() {
+            if let Some(c) = row.iter().position(|v| !v.is_finite()) {
+                return Err(Error::Domain(format!(
+                    "{}: not written: column {} holds {} at row {} (t = {:.4} s)",
+                    path.display(),
+                    self.names.get(c).map_or("?", |n| n.as_str()),
+                    row[c],
+                    r + 1,
+                    row.first().copied().unwrap_or(f64::NAN)
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Writes the rows as CSV with a header line.
@@ -387,6 +405,7 @@ pub fn run_to_csv(
     progress: impl FnMut(f64),
 ) -> Result<RunSummary> {
     let recording = record(sim, progress)?;
+    recording.check_finite(out)?;
     crate::io::write_atomic(out, |w| recording.write_csv(w))?;
     write_meta(out, meta, &recording)
 }

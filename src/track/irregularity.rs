@@ -410,7 +410,9 @@ impl Irregularities {
     #[inline]
     fn locate(&self, s: f64) -> (usize, f64) {
         let n = self.samples[0].len();
-        let u = ((s - self.origin) / self.dx).clamp(1.0, (n - 3) as f64);
+        // `max` before `min`: a NaN position lands on the grid's first interval instead of
+        // an index out of range (the run's own check names the divergence).
+        let u = ((s - self.origin) / self.dx).max(1.0).min((n - 3) as f64);
         let i = (u.floor() as usize).min(n - 3);
         (i, u - i as f64)
     }

@@ -99,10 +99,9 @@ fn default_stop_stiffness() -> f64 {
 
 impl SideBearer {
     fn from_row(f: &str, e: &SideBearerFile, b: &Binder) -> Result<Self> {
-        b.non_negative(
-            format!("{f}.stiffness"),
-            &[e.stiffness, e.preload_n, e.friction],
-        )?;
+        b.non_negative(format!("{f}.stiffness"), &[e.stiffness])?;
+        b.non_negative(format!("{f}.preload_n"), &[e.preload_n])?;
+        b.non_negative(format!("{f}.friction"), &[e.friction])?;
         b.positive(format!("{f}.stick_stiffness"), e.stick_stiffness)?;
         b.non_negative(format!("{f}.damping"), &[e.damping])?;
         b.non_negative(format!("{f}.stop_stiffness"), &[e.stop_stiffness])?;

@@ -154,9 +154,10 @@ impl SpringNest {
         b.positive(format!("{f}.outer_stiffness"), e.outer_stiffness)?;
         b.non_negative(format!("{f}.inner_stiffness"), &[e.inner_stiffness])?;
         b.non_negative(format!("{f}.inner_gap_m"), &[e.inner_gap_m])?;
+        b.non_negative(format!("{f}.control_stiffness"), &[e.control_stiffness])?;
         b.non_negative(
-            format!("{f}.control_stiffness"),
-            &[e.control_stiffness, e.control_extra_height_m],
+            format!("{f}.control_extra_height_m"),
+            &[e.control_extra_height_m],
         )?;
         b.non_negative(format!("{f}.lateral_stiffness"), &e.lateral_stiffness)?;
         b.non_negative(format!("{f}.footprint_m"), &e.footprint_m)?;

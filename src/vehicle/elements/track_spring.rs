@@ -52,10 +52,8 @@ pub(crate) struct TrackSpringFile {
 
 impl TrackSpring {
     fn from_row(f: &str, e: &TrackSpringFile, b: &Binder) -> Result<Self> {
-        b.non_negative(
-            format!("{f}.lateral_stiffness"),
-            &[e.lateral_stiffness, e.yaw_stiffness],
-        )?;
+        b.non_negative(format!("{f}.lateral_stiffness"), &[e.lateral_stiffness])?;
+        b.non_negative(format!("{f}.yaw_stiffness"), &[e.yaw_stiffness])?;
         Ok(TrackSpring {
             body: b.find(format!("{f}.link"), &e.link)?,
             lateral_stiffness: e.lateral_stiffness,

@@ -194,14 +194,13 @@ impl WedgeDamper {
             ));
         }
         b.positive(format!("{f}.stick_stiffness"), e.stick_stiffness)?;
+        b.non_negative(format!("{f}.stick_damping"), &[e.stick_damping])?;
         b.non_negative(
-            format!("{f}.stick_damping"),
-            &[e.stick_damping, e.longitudinal_stiffness],
+            format!("{f}.longitudinal_stiffness"),
+            &[e.longitudinal_stiffness],
         )?;
-        b.non_negative(
-            format!("{f}.warp_stiffness"),
-            &[e.warp_stiffness, e.warp_ratio_m],
-        )?;
+        b.non_negative(format!("{f}.warp_stiffness"), &[e.warp_stiffness])?;
+        b.non_negative(format!("{f}.warp_ratio_m"), &[e.warp_ratio_m])?;
         let (upper, lower, rest) =
             b.pair(f, (&e.upper, &e.lower), e.at, (e.upper_at, e.lower_at))?;
         Ok(WedgeDamper {

@@ -1,0 +1,130 @@
+//! No file crashes a command or makes it write NaN: numbers are held to their physical
+//! bounds at load, naming file and field; a run that blows up says so before any lookup
+//! meets its NaN; and no writer puts a non-finite value in a file.
+
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The C80's file with `edit` applied, loaded from a temporary folder: the error, or "loaded".
+fn load_c80_edited(edit: impl Fn(String) -> String) -> String {
+    let text = std::fs::read_to_string(root().join("vehicles/c80.toml")).unwrap();
+    let urdf = root().join("vehicles/c80.urdf");
+    let text = edit(text).replace(
+        "urdf = \"c80.urdf\"",
+        &format!("urdf = {:?}", urdf.to_string_lossy()),
+    );
+    let dir = std::env::temp_dir().join(format!("railforce-hard-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!(
+        "c80-{}.toml",
+        railforce::io::fnv1a64(text.as_bytes())
+    ));
+    std::fs::write(&path, text).unwrap();
+    let r = railforce::vehicle::Vehicle::load(&path);
+    let _ = std::fs::remove_file(&path);
+    match r {
+        Ok(_) => "loaded".into(),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// Replaces the first `key = value` line of `key` with `key = new`.
+fn set_first(text: &str, key: &str, new: &str) -> String {
+    let mut done = false;
+    text.lines()
+        .map(|l| {
+            if !done && l.trim_start().starts_with(&format!("{key} =")) {
+                done = true;
+                format!("{key} = {new}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn numbers_beyond_their_physical_bound_are_refused_naming_the_field() {
+    assert_eq!(load_c80_edited(|t| t), "loaded");
+    for (key, value, words) in [
+        ("width_m", "1e308", "a width"),
+        ("width_m", "1.5", "a width"),
+        ("stick_stiffness", "1e15", "a stiffness"),
+        ("friction", "7.0", "a friction coefficient"),
+        ("inner_gap_m", "40.0", "a length"),
+    ] {
+        let err = load_c80_edited(|t| set_first(&t, key, value));
+        assert!(
+            err.contains(key) && err.contains("physical bound") && err.contains(words),
+            "{key} = {value}: {err}"
+        );
+        assert!(err.contains(".toml"), "the error names the file: {err}");
+    }
+    // The bounds hold every shipped vehicle.
+    for v in ["c80.toml", "c80_empty.toml", "minimal.toml"] {
+        railforce::vehicle::Vehicle::load(&root().join("vehicles").join(v))
+            .unwrap_or_else(|e| panic!("{v}: {e}"));
+    }
+}
+
+#[test]
+fn a_nan_position_never_reaches_past_a_track_grid() {
+    let track = railforce::track::Track::load(&root().join("tracks/curve_r400.toml")).unwrap();
+    // Every lookup of a non-finite position answers without a panic (the run's own check
+    // names the divergence; the grids must not index out of range first).
+    for s in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -1e308, 1e308] {
+        let r = std::panic::catch_unwind(|| {
+            let _ = track.at(s);
+        });
+        assert!(r.is_ok(), "the track lookup panicked at s = {s}");
+    }
+}
+
+#[test]
+fn a_recording_that_holds_nan_is_not_written() {
+    use railforce::sim::output::Recording;
+    let dir = std::env::temp_dir().join(format!("railforce-hard-rec-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rec = Recording {
+        names: vec!["time_s".into(), "w1l_force_y".into()],
+        units: vec!["s", "N"],
+        rows: vec![vec![0.0, 1.0], vec![0.005, f64::NAN]],
+        summary: Default::default(),
+    };
+    for (format, ext) in [
+        (railforce::dataset::Format::Csv, "csv"),
+        (railforce::dataset::Format::Npz, "npz"),
+        (railforce::dataset::Format::Parquet, "parquet"),
+    ] {
+        let path = dir.join(format!("run.{ext}"));
+        let err = railforce::dataset::write_run(&path, &rec, format, false)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("w1l_force_y") && err.contains("row 2") && err.contains(ext),
+            "{err}"
+        );
+        assert!(!path.exists(), "{} was written", path.display());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_table_with_a_non_finite_cell_is_refused_naming_column_and_row() {
+    let p = std::path::Path::new("identified.csv");
+    assert!(railforce::io::check_csv_finite("time_s,FL\n0,1.5\n0.005,-2e3\n", p).is_ok());
+    for bad in ["NaN", "inf", "-inf", "nan"] {
+        let text = format!("time_s,FL,FQ\n0,1,2\n0.005,3,{bad}\n");
+        let err = railforce::io::check_csv_finite(&text, p)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("identified.csv") && err.contains("FQ") && err.contains("row 2"),
+            "{err}"
+        );
+    }
+}
