@@ -128,3 +128,52 @@ fn a_table_with_a_non_finite_cell_is_refused_naming_column_and_row() {
         );
     }
 }
+
+/// The contact table is cached on disk: a second process reads it instead of building it,
+/// a damaged file is built again, and the run's bytes are the same every way.
+#[test]
+fn the_contact_table_cache_gives_the_same_bytes_and_rebuilds_a_damaged_file() {
+    let dir = std::env::temp_dir().join(format!("railforce-hard-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let cache = dir.join("cache");
+    let run = |name: &str, cache_dir: &str| {
+        let out = dir.join(name);
+        crate::common::succeed(
+            std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+                .env("RAILFORCE_CACHE_DIR", cache_dir)
+                .args(["simulate", "--track", "tangent", "--duration", "0.2"])
+                .args(["--settle", "0.1", "--out"])
+                .arg(&out),
+        );
+        std::fs::read(&out).unwrap()
+    };
+    let c = cache.to_str().unwrap();
+    let cold = run("cold.csv", c);
+    let files: Vec<PathBuf> = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(files.len(), 1, "one table cached: {files:?}");
+    let warm = run("warm.csv", c);
+    assert_eq!(cold, warm, "a cached table gives the same bytes");
+    // Damaged: built again (the same bytes) and the file rewritten whole.
+    let good = std::fs::read(&files[0]).unwrap();
+    let mut bad = good.clone();
+    let mid = bad.len() / 2;
+    bad[mid] ^= 0xff;
+    std::fs::write(&files[0], &bad).unwrap();
+    assert_eq!(run("damaged.csv", c), cold);
+    assert_eq!(
+        std::fs::read(&files[0]).unwrap(),
+        good,
+        "the file is rebuilt"
+    );
+    std::fs::write(&files[0], &good[..good.len() / 3]).unwrap();
+    assert_eq!(run("cut.csv", c), cold);
+    // Off: no cache written, the same bytes.
+    let off_dir = dir.join("never");
+    assert_eq!(run("off.csv", "off"), cold);
+    assert!(!off_dir.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

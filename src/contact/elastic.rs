@@ -219,6 +219,63 @@ impl WheelsetGeometry {
 }
 
 impl StripTable {
+    /// Writes the table's numbers, in order, for the contact table's file
+    /// ([`super::table_cache`]).
+    pub(super) fn encode(&self, e: &mut super::table_cache::Encoder) {
+        e.len(self.windows.len());
+        for w in self.windows.iter().flatten() {
+            for v in [w.first, w.offset, w.len, w.narrow.0, w.narrow.1] {
+                e.u32(v);
+            }
+        }
+        e.len(self.strips.len());
+        for s in &self.strips {
+            e.f64s(s);
+        }
+        for g in &self.gap_y {
+            e.f64s(g);
+        }
+    }
+
+    /// Reads what [`Self::encode`] wrote for `states` tabulated states; `None` where a window
+    /// would reach past the strips (a file is never trusted to index).
+    pub(super) fn decode(d: &mut super::table_cache::Decoder, states: usize) -> Option<Self> {
+        let n = d.len()?;
+        if n != states {
+            return None;
+        }
+        let mut windows = Vec::with_capacity(n);
+        for _ in 0..n {
+            let mut pair = [Window::default(); 2];
+            for w in &mut pair {
+                *w = Window {
+                    first: d.u32()?,
+                    offset: d.u32()?,
+                    len: d.u32()?,
+                    narrow: (d.u32()?, d.u32()?),
+                };
+            }
+            windows.push(pair);
+        }
+        let m = d.len()?;
+        let mut strips = Vec::with_capacity(m);
+        for _ in 0..m {
+            strips.push(d.f64s::<8>()?);
+        }
+        let mut gap_y = Vec::with_capacity(m);
+        for _ in 0..m {
+            gap_y.push(d.f64s::<2>()?);
+        }
+        let fits = windows.iter().flatten().all(|w| {
+            w.first.checked_add(w.len).is_some() && (w.offset as usize + w.len as usize) <= m
+        });
+        fits.then_some(StripTable {
+            windows,
+            strips,
+            gap_y,
+        })
+    }
+
     /// Tabulates the strips of both wheels for every state of a contact table.
     pub(super) fn build(geo: &WheelsetGeometry, states: &[ContactState]) -> Self {
         let mut table = StripTable::default();

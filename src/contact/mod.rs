@@ -10,6 +10,7 @@ mod miniprof;
 pub mod profile;
 mod quasi_static;
 mod table;
+mod table_cache;
 pub mod validate;
 mod wheel_rail;
 

@@ -36,7 +36,10 @@ impl WheelsetGeometry {
         if let Some((_, t)) = built.iter().find(|(k, _)| *k == key) {
             return t.clone();
         }
-        let table = Arc::new(self.table(y_max, dy));
+        // On disk across processes: a run's first result need not wait for the build.
+        let table = Arc::new(super::table_cache::load_or_build(&key, || {
+            self.table(y_max, dy)
+        }));
         if built.len() == KEPT {
             built.remove(0);
         }
@@ -79,10 +82,10 @@ impl WheelsetGeometry {
 /// Contact states tabulated over the lateral shift, for fast lookup during simulation.
 #[derive(Debug, Clone)]
 pub struct ContactTable {
-    y_min: f64,
-    dy: f64,
-    states: Vec<ContactState>,
-    strips: StripTable,
+    pub(super) y_min: f64,
+    pub(super) dy: f64,
+    pub(super) states: Vec<ContactState>,
+    pub(super) strips: StripTable,
 }
 
 impl ContactTable {
