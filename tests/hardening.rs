@@ -177,3 +177,92 @@ fn the_contact_table_cache_gives_the_same_bytes_and_rebuilds_a_damaged_file() {
     assert!(!off_dir.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Mutated vehicle files through the command that reads them: a hostile number (NaN, ±inf,
+/// ±1e308, zero, negative) in a seeded choice of the C80's fields, each run by `simulate`.
+/// Never a panic; a run that ends writes finite numbers only; one refused says why, naming
+/// the file or the divergence.
+#[test]
+#[ignore = "release: simulates 24 mutated wagons (CI runs it)"]
+fn mutated_vehicle_files_never_crash_simulate_or_write_nan() {
+    let dir = std::env::temp_dir().join(format!("railforce-hard-mut-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(root().join("vehicles/c80.urdf"), dir.join("c80.urdf")).unwrap();
+    let text = std::fs::read_to_string(root().join("vehicles/c80.toml")).unwrap();
+    // The lines that set a number (not a comment, not a string).
+    let numeric: Vec<usize> = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            let t = l.trim_start();
+            !t.starts_with('#')
+                && t.split_once('=').is_some_and(|(_, v)| {
+                    v.trim_start()
+                        .starts_with(|c: char| c.is_ascii_digit() || c == '-')
+                })
+        })
+        .map(|(i, _)| i)
+        .collect();
+    let hostile = ["nan", "inf", "-inf", "1e308", "-1e308", "0.0", "-1.0"];
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = |n: usize| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % n as u64) as usize
+    };
+    for case in 0..24 {
+        let line = numeric[next(numeric.len())];
+        let value = hostile[next(hostile.len())];
+        let edited: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| match (i == line, l.split_once('=')) {
+                (true, Some((k, _))) => format!("{k}= {value}"),
+                _ => l.to_string(),
+            })
+            .collect();
+        let file = dir.join(format!("case{case}.toml"));
+        std::fs::write(&file, edited.join("\n")).unwrap();
+        let out = dir.join(format!("case{case}.csv"));
+        let r = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .env("RAILFORCE_CACHE_DIR", dir.join("cache"))
+            .args([
+                "simulate",
+                "--track",
+                "tangent",
+                "--duration",
+                "0.5",
+                "--settle",
+                "0.2",
+            ])
+            .arg("--vehicle")
+            .arg(&file)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&r.stderr);
+        let what = format!("case {case}: line {} = {value}", line + 1);
+        assert_ne!(r.status.code(), Some(101), "{what}: panicked: {stderr}");
+        if r.status.success() {
+            let csv = std::fs::read_to_string(&out).unwrap();
+            railforce::io::check_csv_finite(&csv, &out)
+                .unwrap_or_else(|e| panic!("{what}: wrote a non-finite value: {e}"));
+        } else {
+            assert!(
+                stderr.contains(&format!("case{case}.toml"))
+                    || stderr.contains("diverged")
+                    || stderr.contains("derail"),
+                "{what}: refused without naming the file or the reason: {stderr}"
+            );
+            assert!(
+                !out.exists(),
+                "{what}: a refused run left {}",
+                out.display()
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
