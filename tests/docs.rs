@@ -11,33 +11,50 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Every Markdown file of the project (not under target/ or hidden folders).
+/// Every Markdown file of the project: not in hidden folders, not in the top-level folders
+/// .gitignore names (outputs such as experiments/), never through a symbolic link.
 fn markdown_files() -> Vec<PathBuf> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    let ignored: Vec<String> = std::fs::read_to_string(root().join(".gitignore"))
+        .unwrap_or_default()
+        .lines()
+        .filter_map(|l| {
+            l.trim()
+                .strip_prefix('/')
+                .map(|l| l.trim_end_matches('/').to_string())
+        })
+        .collect();
+    fn walk(dir: &Path, top: bool, ignored: &[String], out: &mut Vec<PathBuf>) {
         let Ok(entries) = std::fs::read_dir(dir) else {
             return;
         };
         for e in entries.flatten() {
             let p = e.path();
             let name = e.file_name().to_string_lossy().to_string();
-            if name.starts_with('.') || name == "target" || name == "node_modules" {
+            let Ok(kind) = e.file_type() else { continue };
+            if name.starts_with('.') || kind.is_symlink() || (top && ignored.contains(&name)) {
                 continue;
             }
-            if p.is_dir() {
-                walk(&p, out);
+            if kind.is_dir() {
+                walk(&p, false, ignored, out);
             } else if name.ends_with(".md") {
                 out.push(p);
             }
         }
     }
     let mut out = Vec::new();
-    walk(&root(), &mut out);
+    walk(&root(), true, &ignored, &mut out);
     out.sort();
     out
 }
 
+/// The path from the project's root, with `/` between its parts on every platform.
 fn rel(p: &Path) -> String {
-    p.strip_prefix(root()).unwrap_or(p).display().to_string()
+    p.strip_prefix(root())
+        .unwrap_or(p)
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join("/")
 }
 
 /// The lines of a Markdown text outside fenced code blocks, with their numbers.
@@ -267,7 +284,7 @@ fn dated_phrase(line: &str) -> Option<String> {
     while let Some(k) = l[from..].find("issue ") {
         let i = from + k;
         if before_edge(i) && b.get(i + 6).is_some_and(|c| c.is_ascii_digit()) {
-            return Some(l[i..(i + 9).min(l.len())].to_string());
+            return Some(l[i..].chars().take(9).collect());
         }
         from = i + 1;
     }

@@ -95,7 +95,7 @@ pub struct ExperimentArgs {
     #[arg(long, default_value = "centre", value_parser = railforce::features::LabelAt::NAMES)]
     label: String,
     /// The former spelling of `--label last`.
-    #[arg(long, hide = true)]
+    #[arg(long, hide = true, conflicts_with = "label")]
     last_label: bool,
     /// Window length, steps (the paper's 20 at 200 Hz = 0.1 s; longer windows average more
     /// noise out and cost proportionally more time).

@@ -367,16 +367,14 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits, coverage: f64) -> Resu
         .calibration
         .as_ref()
         .is_some_and(|c| !c.envelope.is_empty());
-    w.write_all(
-        header(
-            &spec.targets,
-            has_position,
-            banded,
-            &monitor.columns(),
-            enveloped,
-        )
-        .as_bytes(),
-    )?;
+    let head = header(
+        &spec.targets,
+        has_position,
+        banded,
+        &monitor.columns(),
+        enveloped,
+    );
+    w.write_all(head.as_bytes())?;
     let (mut times, mut flagged) = (Vec::new(), Vec::new());
     let off = railforce::learn::windows::label_offset(spec.window, spec.label_at);
     let mut positions = std::collections::VecDeque::with_capacity(spec.window);
@@ -393,7 +391,11 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits, coverage: f64) -> Resu
             let idx = monitor.push(e.time, &e.forces);
             let p = has_position.then(|| positions[off]);
             let n_out = e.outside.as_ref().map(|o| o.len());
-            w.write_all(row(e.time, p, &e.forces, e.bounds.as_deref(), &idx, n_out).as_bytes())?;
+            let line = row(e.time, p, &e.forces, e.bounds.as_deref(), &idx, n_out);
+            // The same check as a batch run's, row by row: a streamed estimate that is not a
+            // number ends the stream instead of being written.
+            railforce::io::check_csv_finite(&format!("{head}{line}"), out)?;
+            w.write_all(line.as_bytes())?;
             times.push(e.time);
             flagged.push(e.outside.unwrap_or_default());
             w.flush()?;

@@ -34,7 +34,7 @@ pub struct SelectArgs {
     #[arg(long, default_value = "centre", value_parser = LabelAt::NAMES)]
     label: String,
     /// The former spelling of `--label centre`.
-    #[arg(long, hide = true)]
+    #[arg(long, hide = true, conflicts_with = "label")]
     centre_label: bool,
     /// The signals to choose from: `paper21` (the paper's 21) or `onboard` (every on-board
     /// measurable signal: body accelerations, angular rates, track-relative displacements

@@ -240,7 +240,7 @@ impl StripTable {
     /// Reads what [`Self::encode`] wrote for `states` tabulated states; `None` where a window
     /// would reach past the strips (a file is never trusted to index).
     pub(super) fn decode(d: &mut super::table_cache::Decoder, states: usize) -> Option<Self> {
-        let n = d.len()?;
+        let n = d.len_of(40)?;
         if n != states {
             return None;
         }
@@ -257,7 +257,7 @@ impl StripTable {
             }
             windows.push(pair);
         }
-        let m = d.len()?;
+        let m = d.len_of(80)?;
         let mut strips = Vec::with_capacity(m);
         for _ in 0..m {
             strips.push(d.f64s::<8>()?);
@@ -266,8 +266,15 @@ impl StripTable {
         for _ in 0..m {
             gap_y.push(d.f64s::<2>()?);
         }
+        // Every index the lookups form (`offset + j − first` for `j` in the window, and the
+        // narrow window inside it) must fit in u32 and land inside the strips.
         let fits = windows.iter().flatten().all(|w| {
-            w.first.checked_add(w.len).is_some() && (w.offset as usize + w.len as usize) <= m
+            let (first, len, offset) = (u64::from(w.first), u64::from(w.len), u64::from(w.offset));
+            first + len + offset <= u64::from(u32::MAX)
+                && offset + len <= m as u64
+                && first <= u64::from(w.narrow.0)
+                && w.narrow.0 <= w.narrow.1
+                && u64::from(w.narrow.1) <= first + len
         });
         fits.then_some(StripTable {
             windows,

@@ -5,6 +5,9 @@
 //! or the table is built again and the file rewritten. The numbers are stored as their bits,
 //! so a run from a cached table writes the same bytes as one from a fresh build.
 //!
+//! The key also carries a hash of the contact module's own source (build.rs), so a table
+//! built by other code is never read back.
+//!
 //! Where: `$RAILFORCE_CACHE_DIR`, else `$XDG_CACHE_HOME/railforce`, else
 //! `$HOME/.cache/railforce`; `RAILFORCE_CACHE_DIR=off` turns the cache off.
 
@@ -17,6 +20,15 @@ use std::path::PathBuf;
 const MAGIC: &[u8; 8] = b"RFCTABLE";
 /// Layout of the file: a change of what a table holds changes it, and old files are rebuilt.
 const VERSION: u32 = 1;
+
+/// The code that builds a table: a hash of the contact module's sources and the crate's
+/// version, made by build.rs. A table built by other code is never read back, so a change of
+/// the contact's physics can never be hidden by a cached table.
+const CODE: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    "-",
+    env!("RAILFORCE_CONTACT_SOURCE_HASH")
+);
 
 /// The cache folder, or `None` when it is turned off or no home is known.
 pub fn cache_dir() -> Option<PathBuf> {
@@ -36,17 +48,19 @@ pub(super) fn load_or_build(key: &[u64], build: impl FnOnce() -> ContactTable) -
     let Some(dir) = cache_dir() else {
         return build();
     };
+    let mut key = key.to_vec();
+    key.push(crate::io::fnv1a64(CODE.as_bytes()));
     let path = dir.join(format!(
         "contact-{:016x}.bin",
         crate::io::fnv1a64(&key.iter().flat_map(|k| k.to_le_bytes()).collect::<Vec<_>>())
     ));
     if let Ok(bytes) = std::fs::read(&path)
-        && let Some(t) = read(&bytes, key)
+        && let Some(t) = read(&bytes, &key)
     {
         return t;
     }
     let table = build();
-    let bytes = write(&table, key);
+    let bytes = write(&table, &key);
     let _ = crate::io::write_atomic(&path, |w| w.write_all(&bytes));
     table
 }
@@ -105,7 +119,8 @@ pub(super) fn read(bytes: &[u8], key: &[u64]) -> Option<ContactTable> {
     }
     let mut d = Decoder(payload);
     let (y_min, dy) = (d.f64()?, d.f64()?);
-    let count = d.len()?;
+    // A state is at least 4 + 2 × 14 numbers and two flags.
+    let count = d.len_of(8 * (4 + 2 * 14) + 8)?;
     if count < 2 || !(dy > 0.0 && y_min.is_finite()) {
         return None;
     }
@@ -217,11 +232,11 @@ impl<'a> Decoder<'a> {
     fn u64(&mut self) -> Option<u64> {
         Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
     }
-    /// A count of items, each at least a byte long: never more than the bytes left (a
-    /// corrupt count must not allocate).
-    pub(super) fn len(&mut self) -> Option<usize> {
+    /// A count of items, each at least `size` bytes long: never more than the bytes left can
+    /// hold (a damaged or forged count must not allocate).
+    pub(super) fn len_of(&mut self, size: usize) -> Option<usize> {
         let n = usize::try_from(self.u64()?).ok()?;
-        (n <= self.0.len()).then_some(n)
+        (n.checked_mul(size)? <= self.0.len()).then_some(n)
     }
     fn f64(&mut self) -> Option<f64> {
         Some(f64::from_bits(self.u64()?))

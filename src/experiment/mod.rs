@@ -385,12 +385,14 @@ fn unix_now() -> u64 {
         .map_or(0, |d| d.as_secs())
 }
 
-/// The commit of the source tree the run was started in (`git rev-parse HEAD`, with
-/// `-modified` when tracked files differ from it), or "unknown" outside a git checkout: the
+/// The commit of the source tree this binary was built from (`git rev-parse HEAD` in it, with
+/// `-modified` when tracked files differ from it), or "unknown" where that tree is gone: the
 /// results snapshot names the code that measured it.
 fn source_commit() -> String {
     let git = |args: &[&str]| {
         std::process::Command::new("git")
+            .arg("-C")
+            .arg(env!("CARGO_MANIFEST_DIR"))
             .args(args)
             .output()
             .ok()

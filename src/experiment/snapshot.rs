@@ -19,46 +19,67 @@ pub const HEADLINE_BEGIN: &str =
 pub const HEADLINE_END: &str = "<!-- results:headline:end -->";
 
 /// Writes the snapshot of the run in `out` to `dest` (atomically), copying the parts'
-/// figures into `dest`'s folder under `results/<part>/` unless `dest` lies in `out`. Refuses
-/// a folder without a finished run (`meta.json` with its wall time).
+/// figures into `dest`'s folder under `results/<part>/` unless `dest` lies in `out`. A run
+/// that has not finished (no `meta.json` of the whole run) is written from the parts that
+/// have, and the snapshot says which are missing; a folder without any part is refused.
 pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
     let meta_path = out.join("meta.json");
-    let meta = read_json(&meta_path).ok_or_else(|| Error::Parse {
-        file: meta_path.clone(),
-        message: "no finished run here (run `railforce experiment all` first)".into(),
-    })?;
-    if meta["wall_seconds"].as_f64().is_none() {
-        return Err(Error::Parse {
-            file: meta_path,
-            message: "the run did not finish (no wall_seconds)".into(),
-        });
-    }
+    let (meta, missing) = match read_json(&meta_path) {
+        Some(m) if m["wall_seconds"].as_f64().is_some() => (m, Vec::new()),
+        _ => partial_meta(out).ok_or_else(|| Error::Parse {
+            file: meta_path.clone(),
+            message: "no finished part of a run here (run `railforce experiment all` first)".into(),
+        })?,
+    };
     let dest_dir = dest
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."))
         .to_path_buf();
     let same = same_dir(&dest_dir, out);
+    // Beside the project's other documents, link them; anywhere else, name them.
+    let docs = dest_dir.ends_with("assets/docs");
+    let doc = |name: &str| {
+        if docs {
+            format!("[{name}]({name})")
+        } else {
+            format!("railforce's assets/docs/{name}")
+        }
+    };
     let mut md = String::new();
     md += "# Results\n\n";
     md += &format!(
-        "Written by `railforce experiment` from its own tables when the run finished: do not edit; rerun and this file is rewritten (`railforce experiment all --plan {} --out {} --results {}`, or `railforce experiment snapshot --out {} --results {}` for a finished folder). The protocol behind every number: [learning.md](learning.md); the words: [glossary.md](glossary.md).\n\n",
+        "Written by `railforce experiment` from its own tables when the run finished: do not edit; rerun and this file is rewritten (`railforce experiment all --plan {} --out {} --results {}`, or `railforce experiment snapshot --out {} --results {}` for a finished folder). The protocol behind every number: {}; the words: {}.\n\n",
         meta["plan_name"].as_str().unwrap_or("?"),
         out.display(),
         dest.display(),
         out.display(),
         dest.display(),
+        doc("learning.md"),
+        doc("glossary.md"),
     );
     let commit = meta["commit"].as_str().unwrap_or("unknown");
-    md += &format!(
-        "- **Run:** finished {} (UTC), railforce {}, commit `{}`, {} wall time in all.\n",
-        meta["finished_unix"]
-            .as_u64()
-            .map_or("?".into(), utc_date_time),
-        meta["railforce_version"].as_str().unwrap_or("?"),
-        commit,
-        minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0)),
-    );
+    if missing.is_empty() {
+        md += &format!(
+            "- **Run:** finished {} (UTC), railforce {}, commit `{}`, {} wall time in all.\n",
+            meta["finished_unix"]
+                .as_u64()
+                .map_or("?".into(), utc_date_time),
+            meta["railforce_version"].as_str().unwrap_or("?"),
+            commit,
+            minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0)),
+        );
+    } else {
+        md += &format!(
+            "- **Run:** not finished: the parts below are those that had finished by {} (UTC), railforce {}, commit `{}`; **not in this snapshot: {}** (no figure of theirs is quoted from another run).\n",
+            meta["finished_unix"]
+                .as_u64()
+                .map_or("?".into(), utc_date_time),
+            meta["railforce_version"].as_str().unwrap_or("?"),
+            commit,
+            missing.join(", "),
+        );
+    }
     for line in protocol_lines(&meta) {
         md += &format!("- {}\n", line.trim_start_matches("Latest run: "));
     }
@@ -73,7 +94,11 @@ pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
         }
     }
     wt.push(vec![
-        "all, with the simulation of the data".into(),
+        if missing.is_empty() {
+            "all, with the simulation of the data".into()
+        } else {
+            "the parts above".into()
+        },
         minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0)),
     ]);
     md += &wt.markdown();
@@ -106,6 +131,41 @@ pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
     }
     crate::io::write_atomic(dest, |w| w.write_all(md.as_bytes()))?;
     Ok(dest.to_path_buf())
+}
+
+/// The run's description from the parts that finished (each part's `meta.json` carries the
+/// run's protocol and its own wall time), and the parts missing; `None` without any part.
+fn partial_meta(out: &Path) -> Option<(serde_json::Value, Vec<String>)> {
+    let mut meta: Option<serde_json::Value> = None;
+    let (mut timings, mut missing) = (serde_json::Map::new(), Vec::new());
+    let mut last = 0u64;
+    for f in Which::FOLDERS {
+        let p = out.join(f).join("meta.json");
+        match (
+            read_json(&p),
+            SavedSection::read(&out.join(f)).ok().flatten(),
+        ) {
+            (Some(m), Some(_)) => {
+                if let Some(s) = m["wall_seconds"].as_f64() {
+                    timings.insert(format!("{f}_s"), serde_json::json!(s));
+                }
+                let modified = std::fs::metadata(&p)
+                    .and_then(|md| md.modified())
+                    .ok()
+                    .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+                    .map_or(0, |d| d.as_secs());
+                last = last.max(modified);
+                meta.get_or_insert(m);
+            }
+            _ => missing.push(f.to_string()),
+        }
+    }
+    let mut meta = meta?;
+    let total: f64 = timings.values().filter_map(|v| v.as_f64()).sum();
+    meta["timings"] = serde_json::Value::Object(timings);
+    meta["wall_seconds"] = serde_json::json!(total);
+    meta["finished_unix"] = serde_json::json!(last);
+    Some((meta, missing))
 }
 
 /// Whether two folders are the same on disk.
@@ -173,7 +233,7 @@ fn headline(out: &Path) -> Result<Table> {
             cell(&t, r, "FQ R²"),
             cell(&t, r, "FL RMSE kN"),
             cell(&t, r, "FQ RMSE kN"),
-            "one CNN-BiLSTM, FL and FQ as two outputs, test on seed 4".into(),
+            "one CNN-BiLSTM, FL and FQ as two outputs, the test runs of the split above".into(),
         ]);
     }
     if let Some(t) = find(&general, "per_condition") {
@@ -207,7 +267,8 @@ fn headline(out: &Path) -> Result<Table> {
                 cell(&t, r, "FQ R²"),
                 cell(&t, r, "FL RMSE kN"),
                 cell(&t, r, "FQ RMSE kN"),
-                "Filter–Wrapper over the on-board candidates, CNN-BiLSTM, test on seed 4".into(),
+                "Filter–Wrapper over the on-board candidates, CNN-BiLSTM, the same test runs"
+                    .into(),
             ]);
         }
     }
@@ -293,7 +354,7 @@ fn headline(out: &Path) -> Result<Table> {
                     cell(&t, r, "FQ R²"),
                     cell(&t, r, "FL RMSE kN"),
                     cell(&t, r, "FQ RMSE kN"),
-                    "the fleet's test wagons (seed 4)".into(),
+                    "the fleet's wagons drawn for the test seeds".into(),
                 ]);
             }
         }

@@ -23,8 +23,8 @@ pub enum LabelAt {
 }
 
 impl LabelAt {
-    /// The names both front ends accept, the default first.
-    pub const NAMES: [&'static str; 2] = ["centre", "last"];
+    /// The names both front ends accept, the default first (`center` too, as [`Self::parse`]).
+    pub const NAMES: [&'static str; 3] = ["centre", "last", "center"];
 
     /// The position a name gives (`centre`, `center` or `last`); the error names the choices.
     pub fn parse(name: &str) -> Result<Self> {
