@@ -276,7 +276,7 @@ fn headline(out: &Path) -> Result<Table> {
         // The seed split is the generalisation's own row.
         for r in t.rows.iter().filter(|r| cell(&t, r, "protocol") != "seeds") {
             h.push(vec![
-                format!("The same network split by {}", cell(&t, r, "protocol")),
+                format!("The CNN-BiLSTM split by {}", cell(&t, r, "protocol")),
                 cell(&t, r, "FL R²"),
                 cell(&t, r, "FQ R²"),
                 cell(&t, r, "FL RMSE kN"),
@@ -364,8 +364,13 @@ fn headline(out: &Path) -> Result<Table> {
 
 /// The condition of the run's one-condition parts.
 fn condition_of(out: &Path) -> String {
-    read_json(&out.join("meta.json"))
-        .and_then(|m| m["condition"].as_str().map(String::from))
+    ["meta.json", "comparison/meta.json", "robustness/meta.json"]
+        .iter()
+        .find_map(|f| {
+            read_json(&out.join(f))?["condition"]
+                .as_str()
+                .map(String::from)
+        })
         .unwrap_or_else(|| "?".into())
 }
 
