@@ -8,29 +8,6 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The C80's file with `edit` applied, loaded from a temporary folder: the error, or "loaded".
-fn load_c80_edited(edit: impl Fn(String) -> String) -> String {
-    let text = std::fs::read_to_string(root().join("vehicles/c80.toml")).unwrap();
-    let urdf = root().join("vehicles/c80.urdf");
-    let text = edit(text).replace(
-        "urdf = \"c80.urdf\"",
-        &format!("urdf = {:?}", urdf.to_string_lossy()),
-    );
-    let dir = std::env::temp_dir().join(format!("railforce-hard-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!(
-        "c80-{}.toml",
-        railforce::io::fnv1a64(text.as_bytes())
-    ));
-    std::fs::write(&path, text).unwrap();
-    let r = railforce::vehicle::Vehicle::load(&path);
-    let _ = std::fs::remove_file(&path);
-    match r {
-        Ok(_) => "loaded".into(),
-        Err(e) => e.to_string(),
-    }
-}
-
 /// Replaces the first `key = value` line of `key` with `key = new`.
 fn set_first(text: &str, key: &str, new: &str) -> String {
     let mut done = false;
@@ -49,7 +26,7 @@ fn set_first(text: &str, key: &str, new: &str) -> String {
 
 #[test]
 fn numbers_beyond_their_physical_bound_are_refused_naming_the_field() {
-    assert_eq!(load_c80_edited(|t| t), "loaded");
+    assert_eq!(crate::common::load_c80_edited(|t| t), "loaded");
     for (key, value, words) in [
         ("width_m", "1e308", "a width"),
         ("width_m", "1.5", "a width"),
@@ -57,7 +34,7 @@ fn numbers_beyond_their_physical_bound_are_refused_naming_the_field() {
         ("friction", "7.0", "a friction coefficient"),
         ("inner_gap_m", "40.0", "a length"),
     ] {
-        let err = load_c80_edited(|t| set_first(&t, key, value));
+        let err = crate::common::load_c80_edited(|t| set_first(&t, key, value));
         assert!(
             err.contains(key) && err.contains("physical bound") && err.contains(words),
             "{key} = {value}: {err}"

@@ -465,31 +465,12 @@ fn run_files_cut_short_are_refused_in_every_format() {
 }
 
 /// The C80 file with `edit` applied, loaded from a temporary copy beside its URDF.
-fn load_edited(edit: impl Fn(String) -> String) -> String {
-    let text = std::fs::read_to_string(root().join("vehicles/c80.toml")).unwrap();
-    let urdf = root().join("vehicles/c80.urdf");
-    let text = edit(text).replace(
-        "urdf = \"c80.urdf\"",
-        &format!("urdf = {:?}", urdf.to_string_lossy()),
-    );
-    let dir = std::env::temp_dir().join(format!("railforce-bogie-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("c80-{}.toml", text.len()));
-    std::fs::write(&path, text).unwrap();
-    let r = railforce::vehicle::Vehicle::load(&path);
-    let _ = std::fs::remove_file(&path);
-    match r {
-        Ok(_) => "loaded".into(),
-        Err(e) => e.to_string(),
-    }
-}
-
 /// One point for both bodies is refused with what to write; a point off its body, or the two
 /// points more than a metre apart, name the element and the field.
 #[test]
 fn one_point_and_misplaced_attachments_are_refused() {
-    assert_eq!(load_edited(|t| t), "loaded");
-    let one = load_edited(|t| {
+    assert_eq!(crate::common::load_c80_edited(|t| t), "loaded");
+    let one = crate::common::load_c80_edited(|t| {
         t.replacen(
             "upper_at = [5.015, 0.978, 0.580]",
             "at = [5.015, 0.978, 0.42]",
@@ -501,7 +482,7 @@ fn one_point_and_misplaced_attachments_are_refused() {
         one.contains("shear_pad[0].at") && one.contains("upper_at") && one.contains("lower_at"),
         "{one}"
     );
-    let off = load_edited(|t| {
+    let off = crate::common::load_c80_edited(|t| {
         t.replacen(
             "lower_at = [5.015, 0.978, 0.555]",
             "lower_at = [5.015, 0.978, 1.555]",
@@ -512,7 +493,7 @@ fn one_point_and_misplaced_attachments_are_refused() {
         off.contains("shear_pad[0].lower_at") && off.contains("does not lie on \"wheelset1\""),
         "{off}"
     );
-    let apart = load_edited(|t| {
+    let apart = crate::common::load_c80_edited(|t| {
         t.replacen(
             "upper_at = [4.100, 0.000, 0.700]",
             "upper_at = [4.100, 0.000, 1.900]",
@@ -523,7 +504,8 @@ fn one_point_and_misplaced_attachments_are_refused() {
         apart.contains("centre_plate[0].lower_at") && apart.contains("at most 1 m apart"),
         "{apart}"
     );
-    let missing = load_edited(|t| t.replacen("lower_at = [4.100, 0.978, 0.300]", "", 1));
+    let missing =
+        crate::common::load_c80_edited(|t| t.replacen("lower_at = [4.100, 0.978, 0.300]", "", 1));
     assert!(
         missing.contains("spring_nest[0].lower_at") && missing.contains("missing"),
         "{missing}"

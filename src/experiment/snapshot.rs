@@ -227,14 +227,12 @@ fn headline(out: &Path) -> Result<Table> {
     if let Some(t) = find(&general, "seed_spread")
         && let Some(r) = t.rows.last()
     {
-        h.push(vec![
+        h.push(metric_row(
+            &t,
+            r,
             "All conditions, the paper's 21 (two training seeds: mean ± half range)".into(),
-            cell(&t, r, "FL R²"),
-            cell(&t, r, "FQ R²"),
-            cell(&t, r, "FL RMSE kN"),
-            cell(&t, r, "FQ RMSE kN"),
             "one CNN-BiLSTM, FL and FQ as two outputs, the test runs of the split above".into(),
-        ]);
+        ));
     }
     if let Some(t) = find(&general, "per_condition") {
         let rows: Vec<&Vec<String>> = t
@@ -257,32 +255,28 @@ fn headline(out: &Path) -> Result<Table> {
             .iter()
             .filter(|r| cell(&t, r, "inputs") != "paper's 21")
         {
-            h.push(vec![
+            h.push(metric_row(
+                &t,
+                r,
                 format!(
                     "Selected on-board sensors ({} channels) at {} dB",
                     cell(&t, r, "channels"),
                     cell(&t, r, "SNR dB")
                 ),
-                cell(&t, r, "FL R²"),
-                cell(&t, r, "FQ R²"),
-                cell(&t, r, "FL RMSE kN"),
-                cell(&t, r, "FQ RMSE kN"),
                 "Filter–Wrapper over the on-board candidates, CNN-BiLSTM, the same test runs"
                     .into(),
-            ]);
+            ));
         }
     }
     if let Some(t) = find(&tables("protocols")?, "protocols") {
         // The seed split is the generalisation's own row.
         for r in t.rows.iter().filter(|r| cell(&t, r, "protocol") != "seeds") {
-            h.push(vec![
+            h.push(metric_row(
+                &t,
+                r,
                 format!("The CNN-BiLSTM split by {}", cell(&t, r, "protocol")),
-                cell(&t, r, "FL R²"),
-                cell(&t, r, "FQ R²"),
-                cell(&t, r, "FL RMSE kN"),
-                cell(&t, r, "FQ RMSE kN"),
                 cell(&t, r, "what the test part is"),
-            ]);
+            ));
         }
     }
     let cmp = tables("comparison")?;
@@ -344,18 +338,16 @@ fn headline(out: &Path) -> Result<Table> {
         // The deployable models: fleet-trained with the weighed mass, on the fleet's test wagons.
         for r in &t.rows {
             if cell(&t, r, "tested on") == "fleet" && cell(&t, r, "inputs").contains("mass") {
-                h.push(vec![
+                h.push(metric_row(
+                    &t,
+                    r,
                     format!(
                         "Wagons never trained on: {}, trained on the {}",
                         cell(&t, r, "inputs"),
                         cell(&t, r, "trained on")
                     ),
-                    cell(&t, r, "FL R²"),
-                    cell(&t, r, "FQ R²"),
-                    cell(&t, r, "FL RMSE kN"),
-                    cell(&t, r, "FQ RMSE kN"),
                     "the fleet's wagons drawn for the test seeds".into(),
-                ]);
+                ));
             }
         }
     }
@@ -372,6 +364,18 @@ fn condition_of(out: &Path) -> String {
                 .map(String::from)
         })
         .unwrap_or_else(|| "?".into())
+}
+
+/// A headline row: what it is, the row's FL and FQ R² and RMSE in kN, and its protocol.
+fn metric_row(t: &Table, r: &[String], what: String, protocol: String) -> Vec<String> {
+    let mut row = vec![what];
+    row.extend(
+        ["FL R²", "FQ R²", "FL RMSE kN", "FQ RMSE kN"]
+            .iter()
+            .map(|c| cell(t, r, c)),
+    );
+    row.push(protocol);
+    row
 }
 
 /// The cell of row `r` under `column`, or [`MISSING`].

@@ -39,3 +39,29 @@ pub fn python_with(modules: &str) -> bool {
     }
     ok
 }
+
+/// The C80's file with `edit` applied, loaded from a temporary folder: the error, or "loaded".
+pub fn load_c80_edited(edit: impl Fn(String) -> String) -> String {
+    let text = std::fs::read_to_string(
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("vehicles/c80.toml"),
+    )
+    .unwrap();
+    let urdf = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("vehicles/c80.urdf");
+    let text = edit(text).replace(
+        "urdf = \"c80.urdf\"",
+        &format!("urdf = {:?}", urdf.to_string_lossy()),
+    );
+    let dir = std::env::temp_dir().join(format!("railforce-edited-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!(
+        "c80-{}.toml",
+        railforce::io::fnv1a64(text.as_bytes())
+    ));
+    std::fs::write(&path, text).unwrap();
+    let r = railforce::vehicle::Vehicle::load(&path);
+    let _ = std::fs::remove_file(&path);
+    match r {
+        Ok(_) => "loaded".into(),
+        Err(e) => e.to_string(),
+    }
+}
