@@ -11,6 +11,7 @@
 
 pub mod angle;
 pub mod assess;
+pub mod bounds;
 pub mod builtin;
 pub mod contact;
 pub mod dataset;

@@ -38,6 +38,8 @@ mod integrator;
 mod learn;
 #[path = "mutation.rs"]
 mod mutation;
+#[path = "mutation_commands.rs"]
+mod mutation_commands;
 #[path = "neural.rs"]
 mod neural;
 #[path = "sensors.rs"]

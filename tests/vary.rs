@@ -221,7 +221,7 @@ fn bad_vary_keys_and_ranges_are_refused_naming_the_key() {
         (
             "\"vehicle.contact.friction\" = { uniform = [-0.1, 0.4] }",
             "vehicle.contact.friction",
-            "must be positive",
+            "outside the physical range of a friction coefficient",
         ),
         (
             "\"vehicle.body.payload.mass\" = { uniform = [1.0, 2.0] }",

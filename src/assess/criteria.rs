@@ -193,10 +193,7 @@ impl Criteria {
 
     /// Parses and checks criteria text (`path` names it in errors).
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let c: Criteria = toml::from_str(text).map_err(|e| Error::Parse {
-            file: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        let c: Criteria = crate::io::parse_toml(text, path)?;
         let positive = |field: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())

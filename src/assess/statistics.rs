@@ -70,7 +70,7 @@ mod tests {
 
     /// Samples every 5 mm (200 Hz at 1 m/s) over `len` metres.
     fn positions(len: f64) -> Vec<f64> {
-        (0..=((len / 0.005).round() as usize))
+        (0..=crate::bounds::to_count((len / 0.005).round()))
             .map(|i| i as f64 * 0.005)
             .collect()
     }

@@ -92,7 +92,7 @@ pub fn run(args: AssessArgs) -> Result<()> {
     railforce::io::write_atomic(&out.join("assessment.md"), |w| w.write_all(md.as_bytes()))?;
     let csv = a.table().csv();
     railforce::io::write_atomic(&out.join("assessment.csv"), |w| w.write_all(csv.as_bytes()))?;
-    let json = serde_json::to_string_pretty(&a)?;
+    let json = railforce::io::to_json_pretty(&a, &out.join("assessment.json"))?;
     railforce::io::write_atomic(&out.join("assessment.json"), |w| {
         w.write_all(json.as_bytes())
     })?;

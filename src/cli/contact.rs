@@ -159,7 +159,7 @@ pub(super) fn range(text: &str, what: &str) -> Result<Vec<f64>> {
     if !(step > 0.0 && step.is_finite() && a.is_finite() && b.is_finite() && b >= a) {
         bail!("{what} {text}: FROM ≤ TO and STEP > 0");
     }
-    let n = ((b - a) / step + 1e-9).floor() as usize + 1;
+    let n = railforce::bounds::to_count(((b - a) / step + 1e-9).floor()) + 1;
     if n > 100_000 {
         bail!("{what} {text}: {n} points, more than 100 000");
     }

@@ -101,6 +101,7 @@ pub fn run(args: SelectArgs) -> Result<()> {
             if r.kept { "yes" } else { "" }
         );
     }
+    railforce::io::check_json_finite(&sel, &args.out)?;
     railforce::io::write_atomic(&args.out, |w| {
         serde_json::to_writer_pretty(&mut *w, &sel).map_err(std::io::Error::other)?;
         w.write_all(b"\n")

@@ -336,7 +336,7 @@ fn fidelity(
         }
         // All three views of both wagons on this pair (sim::modes::compare): the nonlinear
         // critical speeds with their limit cycles, and the first mode to lose its damping.
-        let steps = ((from - to) * 3.6 / 5.0).round() as usize;
+        let steps = railforce::bounds::to_count(((from - to) * 3.6 / 5.0).round());
         let sweep: Vec<f64> = (0..=steps).map(|k| to + k as f64 * 5.0 / 3.6).collect();
         let rows = [
             railforce::sim::modes::compare(&vl, &smooth, &sweep, true)?,

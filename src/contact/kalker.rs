@@ -223,7 +223,7 @@ impl KalkerCoefficients {
             (2.0 - 1.0 / a_over_b).min(1.9)
         };
         // Rows are 0.1 apart in t from 0.1 to 1.9.
-        let i = (((t - 0.1) / 0.1) as usize).min(n_rows - 2);
+        let i = crate::bounds::cell_clamped((t - 0.1) / 0.1, n_rows - 1);
         let (t0, v0) = row(i);
         let (t1, v1) = row(i + 1);
         let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);

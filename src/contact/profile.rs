@@ -36,7 +36,7 @@ impl Profile {
 
     /// Samples `f(y) -> (z, dz/dy, d²z/dy²)` on `[y_min, y_max]`.
     pub fn from_fn(name: &str, y_min: f64, y_max: f64, f: impl Fn(f64) -> (f64, f64, f64)) -> Self {
-        let n = ((y_max - y_min) / GRID_STEP).floor() as usize + 1;
+        let n = crate::bounds::to_count(((y_max - y_min) / GRID_STEP).floor()) + 1;
         let (mut z, mut dz, mut d2z) = (
             Vec::with_capacity(n),
             Vec::with_capacity(n),
@@ -153,7 +153,7 @@ impl Profile {
     /// The `y` where the profile reaches depth `z` on the side `y < y_from` nearest to
     /// `y_from` (e.g. the gauge point 14 mm below the rail top, gauge side negative).
     pub fn crossing_below(&self, y_from: f64, z: f64) -> Option<f64> {
-        let start = ((y_from - self.y0) / self.h) as usize;
+        let start = crate::bounds::cell_clamped((y_from - self.y0) / self.h, self.z.len());
         for i in (0..start.min(self.z.len() - 1)).rev() {
             if (self.z[i] - z) * (self.z[i + 1] - z) <= 0.0 {
                 // Bisection on the interpolant.

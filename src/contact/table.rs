@@ -50,7 +50,7 @@ impl WheelsetGeometry {
     /// Precomputes contact states over `y ∈ [−y_max, y_max]` every `dy` at zero yaw, on all
     /// cores (each shift is solved on its own, so the result does not depend on the threads).
     pub fn table(&self, y_max: f64, dy: f64) -> ContactTable {
-        let n = (y_max / dy).round() as usize;
+        let n = crate::bounds::to_count((y_max / dy).round());
         let ys: Vec<f64> = (0..=2 * n).map(|i| (i as f64 - n as f64) * dy).collect();
         let threads = std::thread::available_parallelism()
             .map(|p| p.get())

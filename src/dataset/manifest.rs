@@ -245,6 +245,7 @@ impl Manifest {
 
     /// Writes the manifest atomically, keys in alphabetical order, pretty-printed.
     pub fn write(&self, path: &Path) -> Result<()> {
+        crate::io::check_json_finite(self, path)?;
         let value = serde_json::to_value(self).map_err(|e| Error::Domain(e.to_string()))?;
         crate::io::write_atomic(path, |w| {
             serde_json::to_writer_pretty(&mut *w, &value).map_err(std::io::Error::other)?;

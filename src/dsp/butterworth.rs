@@ -110,7 +110,7 @@ impl Butterworth {
             return Vec::new();
         }
         let fc = self.k.atan() * self.fs / std::f64::consts::PI;
-        let pad = ((3.0 * self.fs / fc).ceil() as usize).min(n - 1);
+        let pad = crate::bounds::to_count((3.0 * self.fs / fc).ceil()).min(n - 1);
         let (first, last) = (x[0], x[n - 1]);
         let mut ext = Vec::with_capacity(n + 2 * pad);
         ext.extend((1..=pad).rev().map(|k| 2.0 * first - x[k]));

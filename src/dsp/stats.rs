@@ -81,7 +81,11 @@ pub fn percentile(values: &[f64], p: f64) -> f64 {
     }
     v.sort_by(f64::total_cmp);
     let rank = (p.clamp(0.0, 100.0) / 100.0) * (v.len() - 1) as f64;
-    let (lo, hi) = (rank.floor() as usize, rank.ceil() as usize);
+    let n = v.len();
+    let (lo, hi) = (
+        crate::bounds::cell_clamped(rank.floor(), n),
+        crate::bounds::cell_clamped(rank.ceil(), n),
+    );
     v[lo] + (rank - lo as f64) * (v[hi] - v[lo])
 }
 

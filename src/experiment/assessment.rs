@@ -45,7 +45,7 @@ pub(super) fn checks(
         let s: Vec<f64> = mine
             .iter()
             .map(|r| {
-                let i = (((r.2 - t0) * rate).round() as usize).min(s_run.len() - 1);
+                let i = crate::bounds::cell_clamped(((r.2 - t0) * rate).round(), s_run.len());
                 s_run[i]
             })
             .collect();

@@ -128,8 +128,8 @@ impl Samples {
                             "block fractions must satisfy 0 < train, 0 ≤ val, train + val < 1 (got {train}, {val})"
                         )));
                     }
-                    let a = (n as f64 * train).round() as usize;
-                    let b = (n as f64 * (train + val)).round() as usize;
+                    let a = crate::bounds::to_count((n as f64 * train).round());
+                    let b = crate::bounds::to_count((n as f64 * (train + val)).round());
                     tr.push(Block {
                         run: i,
                         from: 0,
@@ -234,8 +234,8 @@ impl Samples {
             }
         }
         all.shuffle(&mut crate::sensors::noise::rng(seed, 0x5348_5546));
-        let a = (all.len() as f64 * train).round() as usize;
-        let b = (all.len() as f64 * (train + val)).round() as usize;
+        let a = crate::bounds::to_count((all.len() as f64 * train).round());
+        let b = crate::bounds::to_count((all.len() as f64 * (train + val)).round());
         Ok(Samples {
             window,
             label_at,

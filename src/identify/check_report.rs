@@ -41,7 +41,7 @@ pub fn write(dir: &Path, runs: &[RunCheck], s: &CheckSettings) -> Result<PathBuf
         "limits": s.limits,
         "runs": runs,
     });
-    let text = serde_json::to_string_pretty(&json).expect("check serialises");
+    let text = crate::io::to_json_pretty(&json, &dir.join("closed_loop.json"))?;
     crate::io::write_atomic(&dir.join("closed_loop.json"), |w| {
         w.write_all(text.as_bytes())
     })?;

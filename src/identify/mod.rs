@@ -196,7 +196,10 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
                     r + 2
                 )));
             }
-            let n = ((t[t.len() - 1] - t[0]) / dt).floor() as usize + 1;
+            let n = crate::bounds::count_of(
+                ((t[t.len() - 1] - t[0]) / dt).floor(),
+                "resampled rows of the sensor file",
+            )? + 1;
             let new_t: Vec<f64> = (0..n).map(|i| t[0] + i as f64 * dt).collect();
             let columns = columns.iter().map(|c| interpolate(t, c, &new_t)).collect();
             let position = position.map(|p| interpolate(t, &p, &new_t));

@@ -93,7 +93,7 @@ fn levels(scores: &[f64]) -> Vec<f64> {
     (0..=LEVELS)
         .map(|i| {
             let c = i as f64 / LEVELS as f64;
-            let rank = ((n + 1) as f64 * c).ceil() as usize;
+            let rank = crate::bounds::to_count(((n + 1) as f64 * c).ceil());
             scores[rank.clamp(1, n) - 1]
         })
         .collect()
@@ -339,7 +339,7 @@ impl Calibration {
     /// `spread` and the window's difficulty [`Calibration::difficulty_of`] is `difficulty`,
     /// standardised units (the stored level at or above `coverage`).
     pub fn half_width(&self, k: usize, coverage: f64, spread: f64, difficulty: f64) -> f64 {
-        let i = ((coverage.clamp(0.0, 1.0) * LEVELS as f64) - 1e-9).ceil() as usize;
+        let i = crate::bounds::to_count(((coverage.clamp(0.0, 1.0) * LEVELS as f64) - 1e-9).ceil());
         let q = match (self.binned.get(k), self.edges.get(k)) {
             (Some(bins), Some(edges)) => {
                 let b = edges.iter().take_while(|&&e| difficulty >= e).count();

@@ -205,7 +205,7 @@ impl Model {
     /// Writes the model directory (atomically file by file).
     pub fn save(&self, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        let json = serde_json::to_string_pretty(&self.meta).expect("model metadata serialises");
+        let json = crate::io::to_json_pretty(&self.meta, &dir.join("model.json"))?;
         crate::io::write_atomic(&dir.join("model.json"), |w| w.write_all(json.as_bytes()))?;
         for (k, e) in std::iter::once(&self.engine)
             .chain(&self.members)

@@ -110,7 +110,9 @@ fn envelope(train: &super::windows::WindowSet) -> Vec<[f64; 2]> {
                 return [f64::NEG_INFINITY, f64::INFINITY];
             }
             v.sort_by(f64::total_cmp);
-            let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+            let q = |p: f64| {
+                v[crate::bounds::cell_clamped(((v.len() - 1) as f64 * p).round(), v.len())]
+            };
             [q(0.001), q(0.999)]
         })
         .collect()

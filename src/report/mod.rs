@@ -81,7 +81,7 @@ impl SavedSection {
     /// Writes `dir/section.json` (the tables and figures it names are the caller's).
     pub fn write(&self, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        let json = serde_json::to_string_pretty(self).expect("section serialises");
+        let json = crate::io::to_json_pretty(self, &dir.join(SECTION_FILE))?;
         crate::io::write_atomic(&dir.join(SECTION_FILE), |w| w.write_all(json.as_bytes()))
     }
 

@@ -40,7 +40,7 @@ pub fn static_loads(vehicle: &Vehicle, seconds: f64) -> Result<StaticCheck> {
         ..SimConfig::default()
     };
     let mut sim = Simulation::new(vehicle, &track, cfg)?;
-    let steps = (seconds / sim.config().dt).round() as usize;
+    let steps = crate::bounds::count_of(seconds / sim.config().dt, "steps of the check")?;
     for _ in 0..steps {
         sim.step()?;
     }

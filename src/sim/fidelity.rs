@@ -152,7 +152,7 @@ fn coast(
     let duration = hold + (from - to) / decel + 2.0;
     let mut sim = kinked(vehicle, track, from, duration, &SimConfig::default())?;
     let lead = 0;
-    let steps_per_block = (1.0 / sim.config().dt).round() as usize;
+    let steps_per_block = crate::bounds::to_count((1.0 / sim.config().dt).round());
     let mut blocks = Vec::new();
     let mut frequencies = Vec::new();
     let mut block = Vec::with_capacity(steps_per_block);

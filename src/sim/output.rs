@@ -50,7 +50,7 @@ impl Recorder {
             .map(|c| (c.name, c.unit))
             .unzip();
         let cfg = sim.config();
-        let every = (1.0 / (cfg.output_rate * cfg.dt)).round().max(1.0) as usize;
+        let every = crate::bounds::to_count((1.0 / (cfg.output_rate * cfg.dt)).round().max(1.0));
         let n = names.len();
         Recorder {
             names,
@@ -347,7 +347,7 @@ pub fn record(sim: &mut Simulation, mut progress: impl FnMut(f64)) -> Result<Rec
         .unwrap_or(2);
     let static_load =
         sim.vehicle().mass() * crate::GRAVITY / sim.vehicle().contact.wheelsets.len() as f64 / 2.0;
-    let total_steps = (duration / sim.config().dt).round() as usize;
+    let total_steps = crate::bounds::count_of(duration / sim.config().dt, "steps of the run")?;
     let mut rows = Vec::with_capacity((duration * sim.config().output_rate) as usize + 1);
     for steps in 0..=total_steps {
         if steps > 0 {
@@ -431,6 +431,7 @@ pub fn write_meta(
         m.insert("rows".into(), recording.rows.len().into());
         m.insert("wall_time_s".into(), recording.summary.wall.into());
     }
+    crate::io::check_json_finite(&meta, &meta_path(out))?;
     crate::io::write_atomic(&meta_path(out), |w| {
         serde_json::to_writer_pretty(&mut *w, &meta).map_err(std::io::Error::other)?;
         w.write_all(b"\n")

@@ -174,7 +174,7 @@ impl Alignment {
         let (mut x, mut y) = (0.0, 0.0);
         a.nodes.push((0.0, 0.0, 0.0));
         for p in a.pieces.clone() {
-            let n = ((p.s1 - p.s0) / 1.0).ceil().max(1.0) as usize;
+            let n = crate::bounds::to_count(((p.s1 - p.s0) / 1.0).ceil().max(1.0));
             let h = (p.s1 - p.s0) / n as f64;
             for j in 0..n {
                 let sa = p.s0 + j as f64 * h;
@@ -192,7 +192,7 @@ impl Alignment {
                 (cs, sn)
             })
             .collect();
-        let metres = a.length().ceil().max(0.0) as usize;
+        let metres = crate::bounds::to_count(a.length().ceil());
         a.lookup = (0..=metres)
             .map(|k| (a.nodes.partition_point(|n| n.0 <= k as f64).max(1) - 1) as u32)
             .collect();

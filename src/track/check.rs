@@ -44,8 +44,8 @@ pub fn rms_checks(irr: &Irregularities, length: f64) -> Vec<RmsCheck> {
 
 fn on_track(irr: &Irregularities, ch: Channel, length: f64) -> &[f64] {
     let x = irr.channel_samples(ch);
-    let first = (-irr.grid_origin() / irr.grid_step()).round() as usize;
-    let last = ((length - irr.grid_origin()) / irr.grid_step()).floor() as usize;
+    let first = crate::bounds::to_count((-irr.grid_origin() / irr.grid_step()).round());
+    let last = crate::bounds::to_count(((length - irr.grid_origin()) / irr.grid_step()).floor());
     &x[first..=last.min(x.len() - 1)]
 }
 

@@ -328,15 +328,15 @@ impl Irregularities {
         use std::f64::consts::PI;
         // 16 points per shortest wavelength keeps cubic interpolation error below 0.1 %.
         let dx = spec.min_wavelength / 16.0;
-        let n_pts = (length / dx).ceil() as usize + 6;
+        let n_pts = crate::bounds::to_count((length / dx).ceil()) + 6;
         let n_fft = (2 * n_pts).next_power_of_two();
         let d_omega = 2.0 * PI / (n_fft as f64 * dx);
         let (w_lo, w_hi) = (
             2.0 * PI / spec.max_wavelength,
             2.0 * PI / spec.min_wavelength,
         );
-        let k_lo = (w_lo / d_omega).ceil().max(1.0) as usize;
-        let k_hi = ((w_hi / d_omega).floor() as usize).min(n_fft / 2 - 1);
+        let k_lo = crate::bounds::to_count((w_lo / d_omega).ceil().max(1.0));
+        let k_hi = crate::bounds::to_count((w_hi / d_omega).floor()).min(n_fft / 2 - 1);
         let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
         let phase = Uniform::new(0.0, 2.0 * PI).expect("valid range");
         let fft = FftPlanner::<f64>::new().plan_fft_inverse(n_fft);
@@ -413,7 +413,7 @@ impl Irregularities {
         // `max` before `min`: a NaN position lands on the grid's first interval instead of
         // an index out of range (the run's own check names the divergence).
         let u = ((s - self.origin) / self.dx).max(1.0).min((n - 3) as f64);
-        let i = (u.floor() as usize).min(n - 3);
+        let i = crate::bounds::cell_clamped(u, n - 2);
         (i, u - i as f64)
     }
 

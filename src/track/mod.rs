@@ -152,7 +152,7 @@ impl Track {
                 "the sampling step must be positive, got {step} m"
             )));
         }
-        let n = (self.length() / step).floor() as usize;
+        let n = crate::bounds::count_of((self.length() / step).floor(), "track samples")?;
         crate::io::write_atomic(path, |w| {
             writeln!(
                 w,

@@ -132,11 +132,14 @@ impl Binder<'_> {
     pub const SPAN: f64 = 1.0;
 
     /// Checks that every value is finite, ≥ 0 and within the physical bound its field
-    /// declares ([`bound_of`]).
+    /// declares ([`crate::bounds::element_bound`]).
     pub fn non_negative(&self, field: impl Into<String>, values: &[f64]) -> Result<()> {
         let field = field.into();
         if let Some(v) = values.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-            return Err(self.err(field, format!("must not be negative, got {v}")));
+            return Err(self.err(
+                field,
+                format!("must not be negative, got {}", crate::bounds::show(*v)),
+            ));
         }
         for &v in values {
             self.within_bound(&field, v)?;
@@ -151,50 +154,24 @@ impl Binder<'_> {
             self.within_bound(&field, v)?;
             Ok(v)
         } else {
-            Err(self.err(field, format!("must be positive, got {v}")))
+            Err(self.err(
+                field,
+                format!("must be positive, got {}", crate::bounds::show(v)),
+            ))
         }
     }
 
     fn within_bound(&self, field: &str, v: f64) -> Result<()> {
-        match bound_of(field) {
+        match crate::bounds::element_bound(field) {
             Some((max, what)) if v.abs() > max => Err(self.err(
                 field,
-                format!("{v} is beyond the physical bound of {max} for {what}"),
+                format!(
+                    "{} is beyond the physical bound of {} for {what}",
+                    crate::bounds::show(v),
+                    crate::bounds::show(max)
+                ),
             )),
             _ => Ok(()),
         }
     }
-}
-
-/// The physical bounds a vehicle file's numbers are held to, by what the field's name says
-/// it is (the most specific suffix first): the largest magnitude and what it measures. A
-/// value beyond them is a typing error or a unit slip, never a wagon (the C80's stiffest
-/// element, a pad, is 2·10⁸ N/m; its largest dimension within an element, 0.76 m).
-const BOUNDS: [(&str, f64, &str); 13] = [
-    ("width_m", 1.0, "a width, m"),
-    ("flange_back_m", 2.0, "a flange-back spacing, m"),
-    ("radius_m", 2.0, "a radius, m"),
-    ("gauge_m", 2.0, "a gauge, m"),
-    ("_m", 1.0, "a length within an element, m"),
-    (
-        "stiffness",
-        1e12,
-        "a stiffness, N/m (N·m/rad for a rotation)",
-    ),
-    ("damping", 1e9, "a damping, N·s/m (N·m·s/rad)"),
-    ("friction", 2.0, "a friction coefficient"),
-    ("young_pa", 1e13, "a Young's modulus, Pa"),
-    ("preload_n", 1e7, "a force, N"),
-    ("ratio", 10.0, "a ratio"),
-    ("proportional", 1e4, "a controller gain, 1/s"),
-    ("integral", 1e6, "a controller gain, 1/s²"),
-];
-
-/// The bound of `field` (its last dotted part), if it declares one.
-pub fn bound_of(field: &str) -> Option<(f64, &'static str)> {
-    let name = field.rsplit('.').next().unwrap_or(field);
-    BOUNDS
-        .iter()
-        .find(|(suffix, _, _)| name.ends_with(suffix))
-        .map(|&(_, max, what)| (max, what))
 }

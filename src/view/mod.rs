@@ -233,7 +233,7 @@ impl Scene {
                 inp.rate_hz
             )));
         }
-        let every = ((1.0 / inp.rate_hz) / dt).round().max(1.0) as usize;
+        let every = crate::bounds::count_of(((1.0 / inp.rate_hz) / dt).max(1.0), "rows per frame")?;
         let rows: Vec<usize> = (0..time.len()).step_by(every).collect();
         let pick = |c: &[f64], scale: f64, dec: i32| -> Vec<f64> {
             rows.iter().map(|&i| round(c[i] * scale, dec)).collect()
@@ -415,7 +415,7 @@ impl Scene {
 
         let track = inp.track;
         let length = track.length();
-        let n_map = ((length / 5.0).ceil() as usize).clamp(2, 4000);
+        let n_map = crate::bounds::to_count((length / 5.0).ceil()).clamp(2, 4000);
         let map = (0..=n_map)
             .map(|j| {
                 let s = length * j as f64 / n_map as f64;

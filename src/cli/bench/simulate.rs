@@ -63,7 +63,7 @@ fn timed_run(base: &SimConfig, speed: f64, seconds: f64) -> (SimConfig, usize) {
         settle: 0.0,
         ..base.clone()
     };
-    let steps = (seconds / cfg.dt).round().max(1.0) as usize;
+    let steps = railforce::bounds::to_count((seconds / cfg.dt).round().max(1.0));
     (cfg, steps)
 }
 

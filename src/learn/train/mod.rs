@@ -462,11 +462,12 @@ impl Trainer {
         let mut mv = self.adam.m.clone();
         mv.extend_from_slice(&self.adam.v);
         write_weights(&out.join("checkpoint_adam.bin"), &mv)?;
+        let log_path = out.join("train_log.jsonl");
         let lines: String = self
             .log
             .iter()
-            .map(|e| serde_json::to_string(e).expect("log serialises") + "\n")
-            .collect();
+            .map(|e| crate::io::to_json(e, &log_path).map(|l| l + "\n"))
+            .collect::<Result<_>>()?;
         crate::io::write_atomic(&out.join("train_log.jsonl"), |w| {
             w.write_all(lines.as_bytes())
         })?;
@@ -479,7 +480,7 @@ impl Trainer {
             fingerprint: fingerprint.to_string(),
             lr_halvings: self.lr_halvings,
         };
-        let ckj = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");
+        let ckj = crate::io::to_json_pretty(&ck, &out.join("checkpoint.json"))?;
         crate::io::write_atomic(&out.join("checkpoint.json"), |w| {
             w.write_all(ckj.as_bytes())
         })
