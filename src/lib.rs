@@ -29,6 +29,7 @@ pub mod report;
 pub mod sensors;
 pub mod sim;
 pub mod track;
+pub mod train;
 pub mod vary;
 pub mod vehicle;
 pub mod view;

@@ -19,6 +19,10 @@ struct PlanFile {
     seeds: Option<SeedsFile>,
     dataset: Option<DatasetFile>,
     vary: Option<toml::Table>,
+    /// The train of every condition that names none (`daqin_20kt`, a file or `none`).
+    consist: Option<String>,
+    /// The wagon's place in that train, a fraction of its length from the head.
+    position: Option<f64>,
     #[serde(default)]
     condition: Vec<ConditionFile>,
 }
@@ -49,6 +53,8 @@ struct ConditionFile {
     seeds: Option<SeedsFile>,
     class: Option<i64>,
     start_m: Option<f64>,
+    consist: Option<String>,
+    position: Option<f64>,
     vary: Option<toml::Table>,
 }
 
@@ -137,6 +143,10 @@ pub struct Condition {
     pub start_m: Option<f64>,
     /// What varies from run to run: the plan's `[vary]` with the condition's own over it.
     pub vary: Vary,
+    /// The train around the wagon (`consist` and `position`; None: the wagon alone).
+    pub train: Option<crate::sim::hitch::TrainSetup>,
+    /// The consist as the plan names it (`daqin_20kt` or a file), for the manifest.
+    pub consist: Option<String>,
 }
 
 impl Condition {
@@ -271,6 +281,24 @@ impl Plan {
                 Some(t) => plan_vary.merged(&Vary::parse(t, path, &f("vary"))?),
                 None => plan_vary.clone(),
             };
+            let consist = c.consist.clone().or_else(|| raw.consist.clone());
+            let position = c.position.or(raw.position);
+            if position.is_some() && consist.is_none() {
+                return Err(Error::config(
+                    path,
+                    f("position"),
+                    "a position in no train: name its `consist` too",
+                ));
+            }
+            let train = match &consist {
+                Some(name) => crate::sim::hitch::TrainSetup::resolve(
+                    name,
+                    position,
+                    dir,
+                    &format!("{}: {}", path.display(), f("consist")),
+                )?,
+                None => None,
+            };
             conditions.push(Condition {
                 vary,
                 name: c.name,
@@ -281,6 +309,8 @@ impl Plan {
                 vehicle: dir.join(c.vehicle.as_deref().unwrap_or(&raw.vehicle)),
                 class: c.class,
                 start_m: c.start_m,
+                train,
+                consist: consist.filter(|n| n != crate::sim::hitch::ALONE),
             });
         }
         // Every file the plan names must be there now, not when its run comes up (checked last,

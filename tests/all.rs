@@ -50,6 +50,10 @@ mod sklearn;
 mod stability;
 #[path = "track.rs"]
 mod track;
+#[path = "train.rs"]
+mod train;
+#[path = "train_coupling.rs"]
+mod train_coupling;
 #[path = "vary.rs"]
 mod vary;
 #[path = "view.rs"]

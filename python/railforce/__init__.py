@@ -71,6 +71,8 @@ def simulate(
     integrator: Optional[str] = None,
     keep_going: bool = False,
     as_frame: bool = False,
+    consist: str = "none",
+    position: Optional[float] = None,
 ):
     """One run of ``vehicle`` on ``track``, exactly as ``railforce simulate`` makes it.
 
@@ -80,7 +82,10 @@ def simulate(
     the run with ``ValueError`` unless ``keep_going``. ``integrator`` (default
     ``"linearly-implicit-hertz"``; ``"linearly-implicit"``, ``"semi-implicit"``, ``"heun"``) and
     ``dt`` (default the integrator's own step: 5/6 ms, 0.5 ms, or 0.2 ms for the last two) as
-    the command line takes them.
+    the command line takes them. ``consist`` (``"none"``: the wagon alone; ``"daqin_10kt"``,
+    ``"daqin_20kt"``, their ``_empty`` forms, or a consist file) and ``position`` (the
+    wagon's place as a fraction of the train from the head) as ``--consist`` and
+    ``--position`` take them; a run in a train adds the ``coupler_*`` channels.
     """
     cols = _native.simulate(
         os.fspath(track),
@@ -93,6 +98,8 @@ def simulate(
         None if dt is None else float(dt),
         integrator,
         bool(keep_going),
+        str(consist),
+        None if position is None else float(position),
     )
     return _frame(cols, as_frame)
 

@@ -48,6 +48,18 @@ pub struct SimulateArgs {
     /// Report a derailment but keep running (default: stop with an error).
     #[arg(long)]
     keep_going: bool,
+    /// The train around the wagon: `none` (the wagon alone, its speed held by the vehicle
+    /// file's `[hauling]`), a built-in consist (`daqin_10kt`, `daqin_20kt`, `_empty` for
+    /// either unloaded) or a consist file. The train's driver holds --speed-kmh by notches;
+    /// its couplers pull and push the carbody at their pivots and height, at the angle the
+    /// neighbours stand on the track. Records `coupler_front_force`, `coupler_rear_force`
+    /// (N, + tension), `coupler_front_yaw`, `coupler_rear_yaw` (rad).
+    #[arg(long, default_value = "none")]
+    consist: String,
+    /// The wagon's place in the train, as a fraction of its length from the head (0 to 1;
+    /// default: the consist file's `position`).
+    #[arg(long, requires = "consist")]
+    position: Option<f64>,
 }
 
 pub fn run(args: SimulateArgs) -> Result<()> {
@@ -76,8 +88,27 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     args.track = super::builtin::resolve(&args.track)?;
     let vehicle = Vehicle::load(&args.vehicle)?;
     let track = Track::new(TrackSpec::load(&args.track)?, args.seed);
+    let mut cfg = cfg;
+    cfg.train = railforce::sim::hitch::TrainSetup::resolve(
+        &args.consist,
+        args.position,
+        std::path::Path::new("."),
+        "--consist",
+    )?;
     let mut sim = Simulation::new(&vehicle, &track, cfg)?;
+    let train_meta = sim.hitch().map(|h| {
+        let t = h.train();
+        serde_json::json!({
+            "consist": args.consist,
+            "position": args.position,
+            "name": t.consist().name,
+            "vehicles": t.consist().vehicles.len(),
+            "wagon_index": t.wagon_index(),
+            "mass_t": t.consist().mass() * 1e-3,
+        })
+    });
     let meta = serde_json::json!({
+        "train": train_meta,
         "tool": format!("railforce {}", env!("CARGO_PKG_VERSION")),
         "vehicle": {"file": args.vehicle, "hash_fnv1a": railforce::dataset::file_hash(&args.vehicle)?, "name": vehicle.name},
         "track": {"file": args.track, "hash_fnv1a": railforce::dataset::file_hash(&args.track)?, "name": track.spec().name},
@@ -141,6 +172,25 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         print!(" {} {:.1}", wheel_name(k), q * 1e-3);
     }
     println!();
+    if let Some(h) = sim.hitch() {
+        let t = h.train();
+        println!(
+            "train {}: wagon {} of {}; the train ran at {:.1} km/h at the end{}",
+            t.consist().name,
+            t.wagon_index() + 1,
+            t.consist().vehicles.len(),
+            t.speed() * 3.6,
+            if t.speed_not_held_s() > 0.0 {
+                format!(
+                    "; its locomotives could not hold {} km/h for {:.1} s (the train slowed, as it would)",
+                    args.speed_kmh,
+                    t.speed_not_held_s()
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
     println!("to watch it: {}", super::view::hint(&args.out, None));
     Ok(())
 }

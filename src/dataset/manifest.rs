@@ -156,6 +156,13 @@ pub struct RunEntry {
     /// Start position along the track, m.
     #[serde(default)]
     pub start_m: Option<f64>,
+    /// The train around the wagon, as the plan names it (absent: the wagon alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub consist: Option<String>,
+    /// The wagon's place in the train, a fraction of its length from the head (absent: the
+    /// consist file's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<f64>,
     /// Rows written. (Format 3 manifests also held each run's wall time, read and
     /// dropped: a manifest holds only what shapes the data, so one plan gives one manifest's
     /// bytes whether one process, shards or workers made it.)
@@ -344,6 +351,12 @@ pub(super) fn run_key(
     }
     if let Some(s) = run.condition.start_m {
         extra += &format!("|start={s}");
+    }
+    if let Some(c) = &run.condition.consist {
+        extra += &format!(
+            "|consist={c}@{:?}",
+            run.condition.train.as_ref().and_then(|t| t.position)
+        );
     }
     if *dataset != DatasetOptions::default() {
         extra += &format!("|dataset={dataset:?}");

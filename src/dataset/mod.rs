@@ -360,6 +360,7 @@ pub fn generate(
             duration: run.condition.duration,
             settle: opts.settle,
             start: run.condition.start_m,
+            train: run.condition.train.clone(),
             dt: opts.stepping.dt,
             integrator: opts.stepping.integrator,
             // A derailment risk (Nadal's limit held 50 ms) is reported and the run kept: a
@@ -396,6 +397,8 @@ pub fn generate(
             vehicle: Some(vehicle.name.clone()),
             class: run.condition.class,
             start_m: run.condition.start_m,
+            consist: run.condition.consist.clone(),
+            position: run.condition.train.as_ref().and_then(|t| t.position),
             rows: rec.rows.len(),
             peak_y_over_q: rec.summary.peak_y_over_q,
             draws: crate::vary::to_json(draws),

@@ -28,7 +28,7 @@ fn kept(name: &str, kind: ChannelKind, subset: &[String]) -> bool {
 }
 
 /// The kinds a plan's `dataset.channels` may name.
-pub const CHANNEL_KINDS: [&str; 8] = [
+pub const CHANNEL_KINDS: [&str; 9] = [
     "axis",
     "input",
     "input_noisy",
@@ -37,6 +37,7 @@ pub const CHANNEL_KINDS: [&str; 8] = [
     "body",
     "deflection",
     "known",
+    "train",
 ];
 
 /// Drops the channels a plan's subset does not keep (see [`kept`]).

@@ -75,7 +75,7 @@ fn dict_of_arrays<'py>(
 
 /// One run, as `railforce simulate` makes it; returns its recorded channels.
 #[pyfunction]
-#[pyo3(signature = (track, vehicle, speed_kmh, duration_s, seed, channels, settle_s, dt, integrator, keep_going))]
+#[pyo3(signature = (track, vehicle, speed_kmh, duration_s, seed, channels, settle_s, dt, integrator, keep_going, consist="none", position=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -89,6 +89,8 @@ fn simulate<'py>(
     dt: Option<f64>,
     integrator: Option<&str>,
     keep_going: bool,
+    consist: &str,
+    position: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = RunRequest {
         speed_kmh,
@@ -97,7 +99,14 @@ fn simulate<'py>(
         stepping: stepping(integrator, dt)?,
         stop_on_derailment: !keep_going,
     };
-    let cfg = request.config().map_err(py_err)?;
+    let mut cfg = request.config().map_err(py_err)?;
+    cfg.train = crate::sim::hitch::TrainSetup::resolve(
+        consist,
+        position,
+        std::path::Path::new("."),
+        "consist",
+    )
+    .map_err(py_err)?;
     let (vehicle, track) = (resolve(&vehicle)?, resolve(&track)?);
     let rec = py
         .detach(|| -> crate::Result<output::Recording> {

