@@ -36,6 +36,13 @@ pub const COUPLER_HEIGHT: f64 = 0.880;
 /// (the C80: 4.1 m of 12 m). An estimate for other vehicles.
 pub const BOGIE_SHARE: f64 = 4.1 / 12.0;
 
+/// The train moves on every this many steps of the run (8.3 ms at the default 5/6 ms step):
+/// the linearly implicit train step is stable there, and the wagon reads its couplers every
+/// step from the neighbours moved on at their velocities
+/// ([`Train::coupler_jacobians_ahead`]). A 212-vehicle train step costs about 5.7 µs: every
+/// 10th step keeps the train near a tenth of the run's step (assets/docs/performance.md).
+pub const TRAIN_EVERY: u32 = 10;
+
 /// Steps between refreshes of the neighbours' chords (their place on the track moves by
 /// under 0.3 m in that time; the chord is shifted along itself in between).
 const REFRESH_STEPS: u64 = 10;
@@ -114,6 +121,10 @@ pub struct Hitch {
     offset: Option<f64>,
     /// Half the wagon's length over its couplers, m.
     half_length: f64,
+    /// Steps of the run since the train's last step.
+    since: u32,
+    /// The carbody's mass, kg (the mass the couplers act on directly).
+    mass: f64,
 }
 
 impl Hitch {
@@ -164,6 +175,8 @@ impl Hitch {
             wheel_radius: vehicle.contact.geometry.nominal_radius,
             offset: None,
             half_length,
+            since: 0,
+            mass: vehicle.bodies[body].mass,
         })
     }
 
@@ -172,17 +185,27 @@ impl Hitch {
         &self.train
     }
 
+    /// The centre-line point at `s` and the track's up direction there; beyond the track's
+    /// ends the line goes on straight along its end's direction (a neighbour may stand off
+    /// the described track).
+    fn point(track: &Track, s: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let end = s.clamp(0.0, track.length());
+        let f = super::TrackFrame::at(track, end);
+        (
+            f.origin + f.axes.column(0) * (s - end),
+            f.axes.column(2).into_owned(),
+        )
+    }
+
     fn chord(track: &Track, n: &Neighbour) -> Chord {
         let a = BOGIE_SHARE * 2.0 * n.half_length;
-        let p1 = super::TrackFrame::at(track, n.centre - a);
-        let p2 = super::TrackFrame::at(track, n.centre + a);
-        let along = (p2.origin - p1.origin)
-            .try_normalize(1e-12)
-            .unwrap_or_else(|| p2.axes.column(0).into_owned());
-        let up = (p1.axes.column(2) + p2.axes.column(2)).normalize();
+        let (o1, z1) = Self::point(track, n.centre - a);
+        let (o2, z2) = Self::point(track, n.centre + a);
+        let along = (o2 - o1).normalize();
+        let up = (z1 + z2).normalize();
         Chord {
             centre: n.centre,
-            mid: 0.5 * (p1.origin + p2.origin),
+            mid: 0.5 * (o1 + o2),
             along,
             up,
             left: up.cross(&along).normalize(),
@@ -237,7 +260,19 @@ impl Hitch {
             self.refreshed = Some(step);
         }
         let offset = self.offset.unwrap_or(0.0);
-        let (f_front, f_rear) = self.train.coupler_forces_at(wagon_s, wagon_v);
+        // The wagon has moved over the train's interval: the train catches up first.
+        if advance && self.since >= TRAIN_EVERY {
+            self.train.step_to(
+                f64::from(self.since) * dt,
+                wagon_s,
+                wagon_v,
+                &TrackRoute(track),
+            );
+            self.since = 0;
+        }
+        let ahead = f64::from(self.since) * dt;
+        let (front, rear) = self.train.coupler_jacobians_ahead(ahead, wagon_s, wagon_v);
+        let (f_front, f_rear) = (front.force, rear.force);
         let n = self.train.neighbours();
         for (k, (force, neighbour)) in [(f_front, n.front), (f_rear, n.rear)]
             .into_iter()
@@ -250,8 +285,9 @@ impl Hitch {
             let sign = if k == 0 { 1.0 } else { -1.0 };
             let local = Vector3::new(sign * self.pivot_local.x, 0.0, self.pivot_local.z);
             let mine = st.position + rot * local;
+            let moved = self.train.velocities()[nb.index] * ahead;
             let theirs = ch.mid
-                + ch.along * (nb.pivot - ch.centre)
+                + ch.along * (nb.pivot + moved - ch.centre)
                 + ch.left * offset
                 + ch.up * COUPLER_HEIGHT;
             let Some(dir) = (theirs - mine).try_normalize(1e-9) else {
@@ -264,6 +300,18 @@ impl Hitch {
                 yaw: crate::angle::atan2(d.y, sign * d.x),
             };
         }
+        // Linearly implicit in the couplers' along-track stiffness and damping (the draft
+        // gears' branch switch is a steep damping, up to about 5·10⁷ N·s/m: explicit, it
+        // would ring an empty carbody at this step): the carbody's whole along-track force
+        // (every other force is in its wrench already) becomes what the implicit Euler step of
+        // its along-track motion gives, F·m / (m + (c + k·Δt)·Δt). At rest in the train (F
+        // = 0) nothing changes.
+        let c = front.damping + rear.damping;
+        let k = front.stiffness + rear.stiffness;
+        let along = frame.axes.column(0).into_owned();
+        let f_along = wrenches[self.body].force.dot(&along);
+        let keep = self.mass / (self.mass + (c + k * dt) * dt);
+        wrenches[self.body].force -= along * (f_along * (1.0 - keep));
         let shoes = self.train.wagon_brake();
         if shoes.normal_force > 0.0 {
             let wheels = 2.0 * self.brake_reactions.len() as f64;
@@ -281,7 +329,7 @@ impl Hitch {
             }
         }
         if advance {
-            self.train.step(dt, wagon_s, wagon_v, &TrackRoute(track));
+            self.since += 1;
         }
     }
 }

@@ -9,12 +9,11 @@
 //! its motion. Nothing allocates in a step.
 
 use super::brake::{BrakeState, Lag};
-use super::consist::{Consist, VehicleKind};
+use super::consist::Consist;
 use super::driver::{Command, Driver};
 use super::locomotive::Locomotive;
 use super::resistance::{BasicResistance, STOP_SPEED, curve_per_kn, grade_force};
 use super::{Route, smooth_sign};
-use crate::error::{Error, Result};
 use tridiagonal::solve_tridiagonal;
 
 mod readout;
