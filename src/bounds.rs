@@ -19,12 +19,13 @@ use std::path::Path;
 /// The physical range of a number by the unit its field's name ends with (the most specific
 /// suffix first): lower bound, upper bound, what it measures. A value beyond them is a typing
 /// error or a unit slip (a track 1 000 km long, a speed of 10⁵ km/h), never a railway.
-pub const UNITS: [(&str, f64, f64, &str); 18] = [
+pub const UNITS: [(&str, f64, f64, &str); 19] = [
     ("_ns_per_m", 0.0, 1e9, "a damping, N·s/m"),
     ("_n_per_m", 0.0, 1e12, "a stiffness, N/m"),
     ("_kmh", 0.0, 400.0, "a speed, km/h"),
     ("_mm", -1e3, 1e3, "a length, mm"),
     ("_m", -1e6, 1e6, "a length or position, m"),
+    ("_m_s", 0.0, 1e4, "a speed, m/s"),
     ("_s", 0.0, 1e6, "a duration, s"),
     ("_hz", 0.0, 1e6, "a frequency, Hz"),
     ("_permille", -100.0, 100.0, "a gradient, ‰"),

@@ -15,6 +15,22 @@ use std::sync::OnceLock;
 pub const FILES: &[(&str, &str)] = &[
     ("vehicles/assessment.toml", crate::assess::criteria::DEFAULT),
     ("vehicles/c80.toml", include_str!("../vehicles/c80.toml")),
+    (
+        "vehicles/daqin_10kt.consist.toml",
+        crate::sim::hitch::BUILTIN_CONSISTS[0].1,
+    ),
+    (
+        "vehicles/daqin_10kt_empty.consist.toml",
+        crate::sim::hitch::BUILTIN_CONSISTS[1].1,
+    ),
+    (
+        "vehicles/daqin_20kt.consist.toml",
+        crate::sim::hitch::BUILTIN_CONSISTS[2].1,
+    ),
+    (
+        "vehicles/daqin_20kt_empty.consist.toml",
+        crate::sim::hitch::BUILTIN_CONSISTS[3].1,
+    ),
     ("vehicles/c80.urdf", include_str!("../vehicles/c80.urdf")),
     (
         "vehicles/c80_empty.toml",

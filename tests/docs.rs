@@ -563,6 +563,18 @@ fn the_channel_table_is_the_recorders() {
     );
     // The recorder records this list (`Recorder::new` builds its columns from it).
     assert_eq!(list.len(), 228, "time_s and 227 channels");
+    // A run in a train adds the couplers' channels, listed in their own table.
+    let train = railforce::sim::channels::channels_of(&v, true);
+    let full = railforce::sim::channels::markdown(
+        &train,
+        &railforce::sensors::label_channels(&v.label_wheel_name()),
+    );
+    for row in full.lines().skip(2 + list.len()) {
+        assert!(
+            doc.contains(row),
+            "assets/docs/channels.md lacks the in-train row of `railforce channels --markdown --in-train`: {row}"
+        );
+    }
 }
 
 #[test]

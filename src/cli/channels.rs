@@ -13,11 +13,15 @@ pub struct ChannelsArgs {
     /// meaning) instead of one `name<TAB>unit<TAB>meaning` line per channel.
     #[arg(long)]
     markdown: bool,
+    /// Add the channels a run in a train records (`simulate --consist`): each coupler's
+    /// force and angle.
+    #[arg(long)]
+    in_train: bool,
 }
 
 pub fn run(args: ChannelsArgs) -> Result<()> {
     let v = railforce::vehicle::Vehicle::load(&super::builtin::resolve(&args.vehicle)?)?;
-    let list = railforce::sim::channels::channels(&v);
+    let list = railforce::sim::channels::channels_of(&v, args.in_train);
     if args.markdown {
         print!(
             "{}",

@@ -353,9 +353,14 @@ pub(super) fn run_key(
         extra += &format!("|start={s}");
     }
     if let Some(c) = &run.condition.consist {
+        // The consist's content too: an edited consist file regenerates its runs.
+        let t = run.condition.train.as_ref();
         extra += &format!(
-            "|consist={c}@{:?}",
-            run.condition.train.as_ref().and_then(|t| t.position)
+            "|consist={c}@{:?}#{:016x}",
+            t.and_then(|t| t.position),
+            t.map_or(0, |t| crate::io::fnv1a64(
+                format!("{:?}", t.consist).as_bytes()
+            ))
         );
     }
     if *dataset != DatasetOptions::default() {

@@ -6,20 +6,23 @@
 //! - **Coupler force**: the 1-D train gives each coupler's force from the along-track
 //!   distance between the wagon (the carbody's place, moved by the 3-D run) and its
 //!   neighbours (moved by the train). Tension positive.
-//! - **Direction**: from the wagon's pivot (on the carbody, `±arm` from its centre at
-//!   [`COUPLER_HEIGHT`]) to the neighbour's pivot. A neighbour is a rigid body whose axis is
+//! - **Direction**: from the wagon's pivot (on the carbody, `±arm` from its centre at the
+//!   consist's coupler height, [`COUPLER_HEIGHT`] in the built-in files) to the neighbour's
+//!   pivot. A neighbour is a rigid body whose axis is
 //!   the chord between its bogie centres on the track centre line, at
 //!   [`BOGIE_SHARE`] of its length either side of its centre (an estimate for vehicles whose
-//!   bogie spacing the consist does not give; the C80's is 8.2 m of 12 m). In a curve of
-//!   radius R both couplers swing inward by about D/(2R) (D the pivot spacing of a car), so
-//!   tension F pulls the wagon inward by about F·D/R, compression pushes it outward.
+//!   bogie spacing the consist does not give; the C80's is 8.2 m of 12 m), offset sideways by
+//!   the carbody's own mean offset from its bogie chord (identical wagons curve alike). In a
+//!   curve of radius R both couplers swing inward by L/(2R) (L the cars' centre spacing), so
+//!   tension F pulls the wagon inward by F·L/R, compression pushes it outward.
 //! - **Brake shoes**: the train's shoe force on the wagon, shared by its wheels, brakes each
 //!   wheelset's spin with μ·N·r per wheel; the reaction turns the body nearest each wheel
 //!   (the side frame that carries the brake beam).
 //!
-//! The train's step is explicit in the coupling: forces at the step's start, the train then
-//! advanced with the wagon where it is. The draft gears' stiffness (tens of MN/m, their solid
-//! stop higher) keeps ω·Δt far below the explicit limit at the run's step.
+//! The train steps every [`TRAIN_EVERY`] run steps, taking the wagon where the run has
+//! moved it; in between the wagon reads its couplers every step from the neighbours moved on
+//! at their velocities. The carbody's along-track pull is linearly implicit in the couplers'
+//! stiffness and damping (the draft gears' branch switch is a steep damping).
 
 use crate::error::Result;
 use crate::track::Track;
@@ -27,9 +30,9 @@ use crate::train::{Consist, Neighbour, Route, Train, WagonAt};
 use crate::vehicle::{BodyState, Vehicle, Wrench};
 use nalgebra::Vector3;
 
-/// Height of the coupler centre line over the rail top, m. TB/T 1010 (the Chinese standard of
-/// coupler height) puts a freight wagon's coupler centre 880 mm above the rail (empty, new
-/// wheels 880 ± 10 mm); taken as the design value, not measured.
+/// Height of the coupler centre line over the rail top in the built-in consists, m: 880 mm,
+/// the figure commonly given for Chinese freight wagons; an estimate (no public text of the
+/// standard was found). A consist file's `coupler.height_m` sets it.
 pub const COUPLER_HEIGHT: f64 = 0.880;
 
 /// A neighbour's bogie centres stand this share of its length either side of its centre
@@ -39,8 +42,9 @@ pub const BOGIE_SHARE: f64 = 4.1 / 12.0;
 /// The train moves on every this many steps of the run (8.3 ms at the default 5/6 ms step):
 /// the linearly implicit train step is stable there, and the wagon reads its couplers every
 /// step from the neighbours moved on at their velocities
-/// ([`Train::coupler_jacobians_ahead`]). A 212-vehicle train step costs about 5.7 µs: every
-/// 10th step keeps the train near a tenth of the run's step (assets/docs/performance.md).
+/// ([`Train::coupler_jacobians_ahead`]). A 212-vehicle train step costs about 5.7 µs
+/// (tests/train.rs, release): every 10th step keeps the train under a tenth of the run's step
+/// (assets/docs/performance.md).
 pub const TRAIN_EVERY: u32 = 10;
 
 /// Steps between refreshes of the neighbours' chords (their place on the track moves by
@@ -61,8 +65,8 @@ pub struct TrainSetup {
     pub position: Option<f64>,
 }
 
-/// The track as the train sees it: grade and curvature, held at the nearest end outside the
-/// described track (the line before and after a track file is taken as it starts and ends).
+/// The track as the train sees it: grade and curvature; beyond the described track the line
+/// goes on straight at its end's grade.
 pub struct TrackRoute<'a>(pub &'a Track);
 
 impl Route for TrackRoute<'_> {
@@ -72,7 +76,12 @@ impl Route for TrackRoute<'_> {
     }
 
     fn curvature(&self, s: f64) -> f64 {
-        self.0.centre_line(s).3
+        // Straight beyond the ends, as the neighbours' geometry is ([`Hitch`]).
+        if (0.0..=self.0.length()).contains(&s) {
+            self.0.centre_line(s).3
+        } else {
+            0.0
+        }
     }
 }
 
@@ -123,6 +132,8 @@ pub struct Hitch {
     half_length: f64,
     /// Steps of the run since the train's last step.
     since: u32,
+    /// The coupler centre line's height over the rail, m (the consist's).
+    height: f64,
     /// The carbody's mass, kg (the mass the couplers act on directly).
     mass: f64,
 }
@@ -142,7 +153,8 @@ impl Hitch {
         let arm = train.wagon_pivot_arm();
         let half_length = 0.5 * train.consist().vehicles[train.wagon_index()].length;
         let cg = vehicle.bodies[body].position;
-        let pivot_local = Vector3::new(arm, 0.0, COUPLER_HEIGHT - cg.z);
+        let height = train.consist().coupler_height;
+        let pivot_local = Vector3::new(arm, 0.0, height - cg.z);
         let wheelsets = &vehicle.contact.wheelsets;
         let half = vehicle.contact.geometry.tape_circle_half;
         let brake_reactions = wheelsets
@@ -176,6 +188,7 @@ impl Hitch {
             offset: None,
             half_length,
             since: 0,
+            height,
             mass: vehicle.bodies[body].mass,
         })
     }
@@ -251,7 +264,7 @@ impl Hitch {
                 },
             );
             let at_height = st.position + rot * Vector3::new(0.0, 0.0, self.pivot_local.z);
-            let y = (at_height - own.mid - own.up * COUPLER_HEIGHT).dot(&own.left);
+            let y = (at_height - own.mid - own.up * self.height).dot(&own.left);
             let waited = self.refreshed.map_or(0, |r| step.saturating_sub(r)) as f64 * dt;
             self.offset = Some(match self.offset {
                 Some(m) => m + (y - m) * (waited / OFFSET_TIME).min(1.0),
@@ -289,7 +302,7 @@ impl Hitch {
             let theirs = ch.mid
                 + ch.along * (nb.pivot + moved - ch.centre)
                 + ch.left * offset
-                + ch.up * COUPLER_HEIGHT;
+                + ch.up * self.height;
             let Some(dir) = (theirs - mine).try_normalize(1e-9) else {
                 continue;
             };
@@ -370,6 +383,11 @@ impl TrainSetup {
         field: &str,
     ) -> Result<Option<TrainSetup>> {
         if spec == ALONE {
+            if let Some(p) = position {
+                return Err(crate::error::Error::Domain(format!(
+                    "{field} = \"{ALONE}\" with position {p}: a position in no train; name a consist"
+                )));
+            }
             return Ok(None);
         }
         let consist = match BUILTIN_CONSISTS.iter().find(|(n, _)| *n == spec) {
