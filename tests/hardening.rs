@@ -243,3 +243,55 @@ fn mutated_vehicle_files_never_crash_simulate_or_write_nan() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A network's weight file holding a NaN is refused at load, naming the file and the weight's
+/// index: every estimate of such a model would be NaN.
+#[test]
+fn a_weight_that_is_not_finite_is_refused_by_index() {
+    use railforce::dataset::{DataSet, Run};
+    use railforce::features::{LabelAt, NoiseProtocol, Split};
+    use railforce::learn::model::{Model, ModelKind, read_weights, write_weights};
+    use railforce::learn::train::{TrainOptions, train};
+    use railforce::learn::windows::DataSpec;
+    let rows = 300;
+    let a: Vec<f64> = (0..rows).map(|t| (0.05 * t as f64).sin()).collect();
+    let y: Vec<f64> = a.iter().map(|v| 1000.0 * v).collect();
+    let time: Vec<f64> = (0..rows).map(|t| t as f64 * 0.005).collect();
+    let ds = DataSet::in_memory(
+        &std::path::PathBuf::from("synthetic"),
+        vec!["time_s".into(), "ws1_acc_y".into(), "w1l_force_y".into()],
+        vec![Run {
+            condition: "c".into(),
+            seed: 1,
+            columns: vec![time, a, y],
+        }],
+    );
+    let spec = DataSpec {
+        channels: vec!["ws1_acc_y".into()],
+        targets: vec!["w1l_force_y".into()],
+        window: 4,
+        label_at: LabelAt::Centre,
+        stride: 1,
+        split: Split::default(),
+        noise: NoiseProtocol::Clean,
+        noise_model: None,
+    };
+    let dir = std::env::temp_dir().join(format!("railforce-nanw-{}", std::process::id()));
+    let opts = TrainOptions {
+        epochs: 1,
+        batch: 32,
+        ..TrainOptions::default()
+    };
+    train(&ds, &spec, ModelKind::Gru, &opts, &dir, &mut |_| {}).unwrap();
+    assert!(Model::load(&dir).is_ok());
+    let w = dir.join("weights.bin");
+    let mut values = read_weights(&w).unwrap();
+    values[3] = f32::NAN;
+    write_weights(&w, &values).unwrap();
+    let err = Model::load(&dir).err().expect("a NaN weight was accepted").to_string();
+    assert!(
+        err.contains("weights.bin") && err.contains("values[3]"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -297,6 +297,14 @@ fn read_engine(dir: &Path, path: &Path, meta: &ModelMeta, suffix: &str) -> Resul
                 ),
             ));
         }
+        // A non-finite weight would make every estimate NaN: refused here, by index.
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::config(
+                &dir.join(format!("weights{suffix}.bin")),
+                format!("values[{i}]"),
+                format!("{} is not a finite weight", values[i]),
+            ));
+        }
         net.params.value = values;
         Engine::Net(Box::new(net))
     } else {
