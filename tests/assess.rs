@@ -18,6 +18,7 @@ fn run(len: f64, y: impl Fn(f64, usize) -> f64, q: impl Fn(f64, usize) -> f64) -
         s: s.clone(),
         wheels: vec![wheel("w1l", 1.0), wheel("w1r", -1.0)],
         carbody: None,
+        couplers: None,
     }
 }
 

@@ -288,7 +288,10 @@ fn a_weight_that_is_not_finite_is_refused_by_index() {
     let mut values = read_weights(&w).unwrap();
     values[3] = f32::NAN;
     write_weights(&w, &values).unwrap();
-    let err = Model::load(&dir).err().expect("a NaN weight was accepted").to_string();
+    let err = Model::load(&dir)
+        .err()
+        .expect("a NaN weight was accepted")
+        .to_string();
     assert!(
         err.contains("weights.bin") && err.contains("values[3]"),
         "{err}"

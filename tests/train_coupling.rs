@@ -122,3 +122,62 @@ fn bad_consists_are_refused_naming_file_and_field() {
         "{err}"
     );
 }
+
+/// `assess` reports each coupler's largest force per section of a run in a train, against the
+/// 2 250 kN limit the criteria cite, and nothing of couplers for a wagon alone.
+#[test]
+fn assess_reports_the_coupler_force_of_a_run_in_a_train() {
+    let dir = std::env::temp_dir().join(format!("railforce-assess-train-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bin = env!("CARGO_BIN_EXE_railforce");
+    let track = root().join("tracks/curve_r800.toml");
+    for (consist, want) in [("daqin_10kt", true), ("none", false)] {
+        let run = dir.join(format!("{consist}.csv"));
+        let out = std::process::Command::new(bin)
+            .args([
+                "simulate",
+                "--duration",
+                "8",
+                "--consist",
+                consist,
+                "--track",
+            ])
+            .arg(&track)
+            .arg("--out")
+            .arg(&run)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let adir = dir.join(format!("a_{consist}"));
+        let out = std::process::Command::new(bin)
+            .arg("assess")
+            .arg(&run)
+            .arg("--out")
+            .arg(&adir)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let csv = std::fs::read_to_string(adir.join("assessment.csv")).unwrap();
+        let rows: Vec<&str> = csv
+            .lines()
+            .filter(|l| l.contains("coupler force"))
+            .collect();
+        if want {
+            assert_eq!(rows.len(), 2, "{csv}");
+            for r in rows {
+                assert!(r.contains("2250"), "{r}");
+            }
+        } else {
+            assert!(rows.is_empty(), "{csv}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

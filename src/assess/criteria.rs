@@ -105,6 +105,16 @@ pub struct Chinese {
     pub source: String,
 }
 
+/// In-train coupler force (runs in a train).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Coupler {
+    /// Largest coupler force, tension or compression, kN.
+    pub limit_kn: f64,
+    /// Where it comes from.
+    pub source: String,
+}
+
 /// Ride index.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -173,6 +183,9 @@ pub struct Criteria {
     pub chinese: Chinese,
     /// Ride index from the carbody accelerations (absent: not assessed).
     pub ride: Option<Ride>,
+    /// Coupler force of a run in a train (absent: not assessed).
+    #[serde(default)]
+    pub coupler: Option<Coupler>,
     /// Running stability (absent: not assessed).
     pub stability: Option<Stability>,
     /// Carbody accelerations (absent: not assessed).
@@ -252,6 +265,9 @@ impl Criteria {
         positive("chinese.derailment", c.chinese.derailment)?;
         positive("chinese.unloading", c.chinese.unloading)?;
         positive("chinese.lateral_alpha", c.chinese.lateral_alpha)?;
+        if let Some(k) = &c.coupler {
+            positive("coupler.limit_kn", k.limit_kn)?;
+        }
         if let Some(r) = &c.ride {
             positive("ride.wz_limit", r.wz_limit)?;
             positive("ride.min_seconds", r.min_seconds)?;
@@ -310,6 +326,7 @@ mod tests {
             &c.lateral_quasi_static.source,
             &c.chinese.source,
             &c.ride.as_ref().unwrap().source,
+            &c.coupler.as_ref().unwrap().source,
             &c.stability.as_ref().unwrap().source,
             &c.carbody_acceleration.as_ref().unwrap().source,
         ] {

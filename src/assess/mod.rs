@@ -60,6 +60,8 @@ pub struct RunForces {
     /// Carbody lateral and vertical accelerations, m/s², where the run has them (the ride
     /// index).
     pub carbody: Option<[Vec<f64>; 2]>,
+    /// Front and rear coupler forces, N (+ tension), where the run was in a train.
+    pub couplers: Option<[Vec<f64>; 2]>,
 }
 
 impl RunForces {
@@ -125,11 +127,25 @@ impl RunForces {
                 r + 1
             )));
         }
+        let couplers = find("coupler_front_force")
+            .zip(find("coupler_rear_force"))
+            .map(|(f, r)| [f, r]);
+        if let Some(r) = couplers
+            .iter()
+            .flat_map(|c| c.iter())
+            .find_map(|v| v.iter().position(|x| !x.is_finite()))
+        {
+            return Err(Error::Domain(format!(
+                "{source}: coupler force, row {}: not a finite number",
+                r + 1
+            )));
+        }
         Ok(RunForces {
             time,
             s,
             wheels,
             carbody,
+            couplers,
         })
     }
 }
@@ -282,6 +298,7 @@ pub fn assess(
         sec.chinese(&mut rows);
         sec.carbody_acceleration(&mut rows);
         sec.ride(&mut rows);
+        sec.couplers(&mut rows);
     }
     if rows.is_empty() {
         return Err(Error::Domain(format!(

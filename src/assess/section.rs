@@ -364,4 +364,35 @@ impl<'a> Section<'a> {
             ));
         }
     }
+
+    /// The largest coupler force of a run in a train, each coupler, against the criteria's
+    /// limit (unfiltered: the draft gears' peaks are the load).
+    pub(super) fn couplers(&self, rows: &mut Vec<Row>) {
+        let (Some(k), Some(f)) = (&self.c.coupler, &self.run.couplers) else {
+            return;
+        };
+        for (series, place) in f.iter().zip(["front coupler", "rear coupler"]) {
+            let peak = self
+                .pick(series)
+                .into_iter()
+                .fold(0.0f64, |m, x| if x.abs() > m.abs() { x } else { m });
+            rows.push(self.row(
+                "coupler force",
+                place,
+                peak.abs() * 1e-3,
+                k.limit_kn,
+                "kN",
+                format!(
+                    "largest |force| over the section ({} kN, {})",
+                    crate::bounds::show((peak * 1e-3 * 10.0).round() / 10.0),
+                    if peak >= 0.0 {
+                        "tension"
+                    } else {
+                        "compression"
+                    }
+                ),
+                "coupler",
+            ));
+        }
+    }
 }

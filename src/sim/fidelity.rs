@@ -169,6 +169,7 @@ fn coast(
             })
             .collect(),
         carbody: None,
+        couplers: None,
     };
     let every = (1.0 / (crate::sensors::RATE_HZ * sim.config().dt))
         .round()
@@ -575,6 +576,7 @@ mod tests {
                 s: vec![],
                 wheels: vec![],
                 carbody: None,
+                couplers: None,
             },
         };
         let (v, f) = c.cycle_frequency().unwrap();

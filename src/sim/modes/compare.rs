@@ -60,6 +60,7 @@ impl Nonlinear {
                 })
                 .collect(),
             carbody: None,
+            couplers: None,
         };
         let running_stability_kn = crate::assess::assess(&running, &[], &criteria, q0_kn)
             .ok()
