@@ -419,3 +419,52 @@ impl TrainSetup {
         Ok(Some(TrainSetup { consist, position }))
     }
 }
+
+/// The wagon's longitudinal drive: alone, the vehicle file's speed control; in a train, the
+/// train.
+impl super::Simulation<'_> {
+    /// Speed control: the rest of the train pulls or brakes the wagon at the carbody, PI on
+    /// the along-track speed plus the gradient's share of the weight as feed-forward.
+    pub(super) fn haul(&mut self, integrate: bool) {
+        let Some(h) = self.vehicle.hauling else {
+            return;
+        };
+        let f = self.frames[h.body];
+        let along = f.axes.column(0).into_owned();
+        let v = self.states[h.body].velocity.dot(&along);
+        let err = self.cfg.speed - v;
+        if integrate {
+            self.hauling_integral += err * self.cfg.dt;
+        }
+        let m = self.vehicle.mass();
+        let force = m
+            * (h.proportional * err
+                + h.integral * self.hauling_integral
+                // sin(atan g) = g / √(1 + g²)
+                + crate::GRAVITY * f.point.gradient / (1.0 + f.point.gradient.powi(2)).sqrt());
+        self.wrenches[h.body].force += along * force;
+    }
+
+    /// The train: its couplers' forces on the carbody and its shoes on the treads; with
+    /// `advance`, the train moves on by one step.
+    pub(super) fn pull(&mut self, advance: bool) {
+        let Some(h) = self.hitch.as_deref_mut() else {
+            return;
+        };
+        h.apply(
+            self.track,
+            &self.states,
+            self.body_s[h.body],
+            &self.frames[h.body],
+            self.step_count,
+            self.cfg.dt,
+            advance,
+            &mut self.wrenches,
+        );
+    }
+
+    /// The train the run's carbody is coupled into, if any.
+    pub fn hitch(&self) -> Option<&Hitch> {
+        self.hitch.as_deref()
+    }
+}
