@@ -135,37 +135,13 @@ fn a_bad_consist_file_is_refused_naming_the_file_and_the_field() {
 }
 
 /// Resistance of vehicle `i` of `c` at `v` on `route`, N, positive against the motion.
-fn resisting(c: &Consist, i: usize, v: f64, route: &ConstantRoute) -> f64 {
-    let veh = &c.vehicles[i];
-    -(veh.resistance.force(veh.mass, v).0
-        + curve_force(veh.mass, route.curvature, v)
-        + grade_force(veh.mass, route.grade))
-}
-
 /// Runs `c` alone at 60 km/h on `route` for `seconds` and checks each coupler against the
 /// resistance behind it less the traction behind it; returns the largest relative error
 /// (against each coupler's own force, at least `floor` N).
 fn steady_error(c: Consist, route: ConstantRoute, seconds: f64, floor: f64) -> f64 {
-    let v0 = 60.0 * KMH;
-    let mut t = Train::new(c, WagonAt::File, 1000.0, v0, &route).unwrap();
-    t.run_alone(seconds, DT, &route, &mut |_| {});
-    let c = t.consist();
-    let u = t.driver().control();
-    let n = c.vehicles.len();
-    assert!((t.speed() - v0).abs() < 1e-3, "speed {}", t.speed());
-    assert!(t.speed_held());
-    let mut worst: f64 = 0.0;
-    let mut behind = 0.0;
-    for j in (0..n - 1).rev() {
-        let i = j + 1;
-        behind += resisting(c, i, t.velocities()[i], &route);
-        if let Some(l) = &c.vehicles[i].locomotive {
-            behind -= l.effort(u, t.velocities()[i]);
-        }
-        let f = t.coupling_force(j);
-        worst = worst.max((f - behind).abs() / behind.abs().max(floor));
-    }
-    worst
+    railforce::train::checks::steady_couplers(c, route, 60.0 * KMH, seconds, DT, floor)
+        .unwrap()
+        .worst
 }
 
 #[test]

@@ -26,6 +26,7 @@
 //! the line through [`Route`].
 
 pub mod brake;
+pub mod checks;
 pub mod consist;
 pub mod draft_gear;
 pub mod driver;
