@@ -124,7 +124,8 @@ fn bad_consists_are_refused_naming_file_and_field() {
 }
 
 /// `assess` reports each coupler's largest force per section of a run in a train, against the
-/// 2 250 kN limit the criteria cite, and nothing of couplers for a wagon alone.
+/// 2 250 kN limit the criteria cite, and `view` carries the couplers to draw; nothing of
+/// couplers for a wagon alone.
 #[test]
 fn assess_reports_the_coupler_force_of_a_run_in_a_train() {
     let dir = std::env::temp_dir().join(format!("railforce-assess-train-{}", std::process::id()));
@@ -165,6 +166,18 @@ fn assess_reports_the_coupler_force_of_a_run_in_a_train() {
             "{}",
             String::from_utf8_lossy(&out.stderr)
         );
+        let out = std::process::Command::new(bin)
+            .arg("view")
+            .arg(&run)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let html = std::fs::read_to_string(run.with_extension("view.html")).unwrap();
+        assert_eq!(html.contains("\"couplers\":{\"force\""), want);
         let csv = std::fs::read_to_string(adir.join("assessment.csv")).unwrap();
         let rows: Vec<&str> = csv
             .lines()

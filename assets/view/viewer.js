@@ -191,6 +191,28 @@
         g.fillText("y " + fmt(body.y[frame], 1), X(body.x) - 24, Y(yc(body.x) - 1.45));
       }
     }
+    // A run in a train: each coupler from the carbody's end towards its neighbour, turned by
+    // the carbody's yaw and its own angle to the carbody (both exaggerated as the yaw), red in
+    // tension, blue in compression, thicker with the force; the neighbours' ends beyond.
+    const C = S.couplers, cb = S.bodies.find((b) => b.kind === "carbody");
+    if (C && cb) {
+      const half = shapes.carbody[0] / 2, len = 1.6;
+      for (const [i, dir] of [[0, 1], [1, -1]]) {
+        const F = C.force[i][frame], psi = C.yaw[i][frame] / 1000 * FY;
+        const off = cb.y0 + cb.y[frame] / 1000 * FL, yaw = cb.yaw[frame] / 1000 * FY;
+        const x = cb.x + dir * half;
+        g.save(); g.translate(X(x), Y(yc(x))); g.rotate(-slope(x)); g.translate(0, -off * k); g.rotate(-yaw);
+        g.strokeStyle = F >= 0 ? COL.limit : COL.truth;
+        g.lineWidth = 2 + 6 * Math.min(1, Math.abs(F) / C.limit_kn);
+        g.beginPath(); g.moveTo(0, 0); g.lineTo(dir * len * k * Math.cos(psi), -len * k * Math.sin(dir * psi)); g.stroke();
+        g.restore();
+        g.fillStyle = F >= 0 ? COL.limit : COL.truth; g.font = "bold 14px system-ui, sans-serif";
+        g.textAlign = dir > 0 ? "right" : "left";
+        g.fillText((i ? "rear coupler: " : "front coupler: ") + (F >= 0 ? "tension " : "compression ") + Math.abs(F).toFixed(0) + " kN, angle " + fmt(C.yaw[i][frame], 1) + " mrad",
+          dir > 0 ? Wd - 10 : 10, top + 20);
+        g.textAlign = "left";
+      }
+    }
     g.fillStyle = COL.ink; g.font = "14px system-ui, sans-serif";
     g.fillText("running direction →", Wd - 170, c.height - 8);
     g.fillText("left rail", 8, Y(yc(-cx / k) + hgm) - 6);

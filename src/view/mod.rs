@@ -60,6 +60,19 @@ pub struct Scene {
     pub identified_source: Option<String>,
     /// Limits drawn on the traces.
     pub limits: Limits,
+    /// The couplers of a run in a train, frame by frame (absent for a wagon alone).
+    pub couplers: Option<CouplerFrames>,
+}
+
+/// The wagon's two couplers, frame by frame: what the plan view draws at the carbody's ends.
+#[derive(Debug, Clone, Serialize)]
+pub struct CouplerFrames {
+    /// Front and rear coupler force, kN (+ tension).
+    pub force: [Vec<f64>; 2],
+    /// Front and rear coupler angle to the carbody's axis, mrad (+ toward its left).
+    pub yaw: [Vec<f64>; 2],
+    /// Largest |force| the criteria allow, kN (the line turns red beyond it).
+    pub limit_kn: f64,
 }
 
 /// Wheel and rail profiles as the cross-section draws them.
@@ -462,6 +475,26 @@ impl Scene {
                 ", irregularity seed {s}"
             )),
         );
+        let find = |name: &str| {
+            cols.iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, c)| c.as_slice())
+        };
+        let couplers = match (
+            find("coupler_front_force"),
+            find("coupler_rear_force"),
+            find("coupler_front_yaw"),
+            find("coupler_rear_yaw"),
+        ) {
+            (Some(ff), Some(fr), Some(yf), Some(yr)) => Some(CouplerFrames {
+                force: [pick(ff, 1e-3, 1), pick(fr, 1e-3, 1)],
+                yaw: [pick(yf, 1e3, 2), pick(yr, 1e3, 2)],
+                limit_kn: crate::assess::criteria::Criteria::builtin()
+                    .coupler
+                    .map_or(2250.0, |c| c.limit_kn),
+            }),
+            _ => None,
+        };
         Ok(Scene {
             title: format!("railforce view: {source}"),
             subtitle,
@@ -487,6 +520,7 @@ impl Scene {
             identified,
             identified_source,
             limits: inp.limits.clone(),
+            couplers,
         })
     }
 }
