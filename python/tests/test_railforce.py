@@ -10,6 +10,24 @@ import pytest
 import railforce
 
 
+def test_simulate_in_a_train_matches_the_cli_and_refuses_a_position_in_no_train(cli, tmp_path):
+    out = tmp_path / "train.npz"
+    subprocess.run(
+        [str(cli), "simulate", "--track", "curve_r800", "--duration", "1", "--settle", "0.5",
+         "--seed", "3", "--consist", "daqin_10kt", "--position", "0.5", "--out", str(out)],
+        check=True, capture_output=True,
+    )
+    ref = np.load(out)
+    py = railforce.simulate(track="curve_r800", duration_s=1, settle_s=0.5, seed=3,
+                            consist="daqin_10kt", position=0.5)
+    assert list(py) == list(ref.files)
+    for name in ("coupler_front_force", "coupler_rear_force", "coupler_front_yaw", "coupler_rear_yaw"):
+        np.testing.assert_array_equal(py[name], ref[name], err_msg=name)
+    assert py["coupler_front_force"].mean() > 0  # mid-train at constant speed: in tension
+    with pytest.raises(ValueError, match="no train"):
+        railforce.simulate(track="curve_r800", duration_s=1, position=0.5)
+
+
 def test_simulate_returns_the_cli_numbers_for_the_same_seed(cli, tmp_path):
     out = tmp_path / "run.npz"
     subprocess.run(
