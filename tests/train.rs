@@ -480,3 +480,52 @@ fn builtin_paths_are_the_shipped_files() {
         assert!(p.ends_with(format!("vehicles/{name}.consist.toml")));
     }
 }
+
+/// Down a 20 ‰ grade the two HXD1's dynamic brakes cannot hold a loaded 20 000 t train at
+/// 60 km/h: without the air brake it runs away; with the driver's cyclic air braking it stays
+/// between the release and the application speeds (with the brake's lag as margin).
+#[test]
+fn cyclic_air_braking_holds_the_speed_down_a_long_grade() {
+    let down = ConstantRoute {
+        grade: -0.020,
+        curvature: 0.0,
+    };
+    let v0 = 60.0 * KMH;
+    let dt = 1.0 / 120.0;
+    let run = |cyclic: bool| {
+        let mut c = load("daqin_20kt");
+        assert!(
+            c.driver.cyclic.is_some(),
+            "the built-in driver brakes cyclically"
+        );
+        if !cyclic {
+            c.driver.cyclic = None;
+        }
+        let mut t = Train::new(c, WagonAt::File, 0.0, v0, &down).unwrap();
+        let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+        t.run_alone(300.0, dt, &down, &mut |t| {
+            lo = lo.min(t.speed());
+            hi = hi.max(t.speed());
+        });
+        (lo, hi, t.driver().applications())
+    };
+    let (_, hi, n) = run(false);
+    assert!(
+        hi > v0 + 10.0 * KMH && n == 0,
+        "without the air brake: up to {} km/h",
+        hi / KMH
+    );
+    let (lo, hi, n) = run(true);
+    eprintln!(
+        "down 20 ‰ at 60 km/h: {:.1}–{:.1} km/h over 300 s, {n} applications",
+        lo / KMH,
+        hi / KMH
+    );
+    assert!(n >= 1, "no application");
+    assert!(
+        hi < v0 + 12.0 * KMH && lo > v0 - 25.0 * KMH,
+        "with cyclic braking: {:.1}–{:.1} km/h, {n} applications",
+        lo / KMH,
+        hi / KMH
+    );
+}

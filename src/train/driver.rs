@@ -54,6 +54,30 @@ pub struct DriverSettings {
     pub tolerance: f64,
     /// Timed commands, times ascending.
     pub schedule: Vec<ScheduleEntry>,
+    /// Cyclic air braking while holding a speed on a descent (None: the dynamic brake only).
+    pub cyclic: Option<CyclicBraking>,
+}
+
+/// Cyclic air braking, as heavy-haul drivers hold a speed down a long grade the dynamic brake
+/// alone cannot hold: with the dynamic brake at its full notch and the train running
+/// `apply_above` faster than the speed held, a service application of `level`; deeper by
+/// `level` again every [`CyclicBraking::DEEPEN_AFTER`] seconds while the train still gains
+/// speed above that, up to a full service; released when the train has slowed to
+/// `release_below` under the speed held, and again on the next rise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CyclicBraking {
+    /// Speed above the held one at which the driver applies the air brake, m/s.
+    pub apply_above: f64,
+    /// Speed below the held one at which the driver releases it, m/s.
+    pub release_below: f64,
+    /// Share of a full service the application makes, in (0, 1].
+    pub level: f64,
+}
+
+impl CyclicBraking {
+    /// Seconds between deepening steps of an application that does not slow the train (the
+    /// brake cylinders take seconds to fill: an estimate of a driver's patience).
+    pub const DEEPEN_AFTER: f64 = 10.0;
 }
 
 /// Quarter-notch hysteresis of the quantiser: the notch moves when the controller asks for
@@ -73,6 +97,14 @@ pub struct Driver {
     next_entry: usize,
     not_held_s: f64,
     not_held: bool,
+    /// Whether the cyclic braking has the air brake applied, at which level, since when, and
+    /// at what speed.
+    air_on: bool,
+    air_level: f64,
+    air_since: f64,
+    air_speed: f64,
+    /// Cyclic applications made.
+    applications: u32,
 }
 
 impl Driver {
@@ -88,6 +120,11 @@ impl Driver {
             next_entry: 0,
             not_held_s: 0.0,
             not_held: false,
+            air_on: false,
+            air_level: 0.0,
+            air_since: 0.0,
+            air_speed: 0.0,
+            applications: 0,
         };
         d.notch = d.nearest_notch(u0);
         d.control = d.quantised(u0);
@@ -145,6 +182,11 @@ impl Driver {
     /// Total time the target speed was not held, s.
     pub fn not_held_s(&self) -> f64 {
         self.not_held_s
+    }
+
+    /// Cyclic air-brake applications made so far.
+    pub fn applications(&self) -> u32 {
+        self.applications
     }
 
     /// Whether the target speed is not held now (control saturated, error beyond tolerance).
@@ -212,6 +254,27 @@ impl Driver {
                 self.control = self.control_of(self.notch);
             }
         }
+        if let Some(cy) = s.cyclic {
+            if !self.air_on && self.control <= -1.0 && v > target + cy.apply_above {
+                air(Command::AirBrake(cy.level));
+                (self.air_on, self.air_level) = (true, cy.level);
+                (self.air_since, self.air_speed) = (t, v);
+                self.applications += 1;
+            } else if self.air_on
+                && self.air_level < 1.0
+                && t - self.air_since >= CyclicBraking::DEEPEN_AFTER
+                && v > target + cy.apply_above
+                && v >= self.air_speed
+            {
+                // Still gaining speed: deeper.
+                self.air_level = (self.air_level + cy.level).min(1.0);
+                air(Command::AirBrake(self.air_level));
+                (self.air_since, self.air_speed) = (t, v);
+            } else if self.air_on && v < target - cy.release_below {
+                air(Command::Release);
+                self.air_on = false;
+            }
+        }
         let saturated = (e > 0.0 && self.control >= 1.0) || (e < 0.0 && self.control <= -1.0);
         self.not_held = saturated && e.abs() > s.tolerance;
         if self.not_held {
@@ -232,6 +295,7 @@ mod tests {
             integral: 0.02,
             notch_interval: 1.0,
             tolerance: 0.5,
+            cyclic: None,
             schedule: vec![
                 ScheduleEntry {
                     time: 1.0,

@@ -73,6 +73,15 @@ pub(super) struct DriverFile {
     pub(super) tolerance_kmh: f64,
     #[serde(default)]
     pub(super) schedule: Vec<ScheduleFile>,
+    pub(super) cyclic: Option<CyclicFile>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct CyclicFile {
+    pub(super) apply_above_kmh: f64,
+    pub(super) release_below_kmh: f64,
+    pub(super) level: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -387,5 +396,21 @@ pub(super) fn driver(c: &Check, d: &DriverFile) -> Result<DriverSettings> {
         notch_interval: c.non_negative("driver.notch_interval_s", d.notch_interval_s, 60.0)?,
         tolerance: c.positive("driver.tolerance_kmh", d.tolerance_kmh, 100.0)? / 3.6,
         schedule,
+        cyclic: match &d.cyclic {
+            None => None,
+            Some(cy) => Some(crate::train::driver::CyclicBraking {
+                apply_above: c.positive(
+                    "driver.cyclic.apply_above_kmh",
+                    cy.apply_above_kmh,
+                    100.0,
+                )? / 3.6,
+                release_below: c.positive(
+                    "driver.cyclic.release_below_kmh",
+                    cy.release_below_kmh,
+                    100.0,
+                )? / 3.6,
+                level: c.positive("driver.cyclic.level", cy.level, 1.0)?,
+            }),
+        },
     })
 }
