@@ -221,7 +221,7 @@ impl WheelsetGeometry {
 impl StripTable {
     /// Writes the table's numbers, in order, for the contact table's file
     /// ([`super::table_cache`]).
-    pub(super) fn encode(&self, e: &mut super::table_cache::Encoder) {
+    pub(super) fn encode(&self, e: &mut super::codec::Encoder) {
         e.len(self.windows.len());
         for w in self.windows.iter().flatten() {
             for v in [w.first, w.offset, w.len, w.narrow.0, w.narrow.1] {
@@ -239,7 +239,7 @@ impl StripTable {
 
     /// Reads what [`Self::encode`] wrote for `states` tabulated states; `None` where a window
     /// would reach past the strips (a file is never trusted to index).
-    pub(super) fn decode(d: &mut super::table_cache::Decoder, states: usize) -> Option<Self> {
+    pub(super) fn decode(d: &mut super::codec::Decoder, states: usize) -> Option<Self> {
         let n = d.len_of(40)?;
         if n != states {
             return None;

@@ -1,5 +1,6 @@
 //! Wheel–rail contact: profiles, contact geometry, Hertz normal contact, creep forces.
 
+mod codec;
 mod creep;
 mod elastic;
 mod geometry;

@@ -5,48 +5,8 @@
 use super::elastic::StripTable;
 use super::geometry::{ContactState, WheelContact, WheelsetGeometry};
 use super::hertz::HertzShape;
-use std::sync::{Arc, Mutex};
-
-/// Tables built in this process, by the exact geometry (and range) they tabulate: most wagons
-/// of a fleet differ from each other in mass, friction or stiffness, not in profiles.
-static BUILT: Mutex<Vec<(Vec<u64>, Arc<ContactTable>)>> = Mutex::new(Vec::new());
-
-/// Tables [`BUILT`] keeps (the newest).
-const KEPT: usize = 8;
 
 impl WheelsetGeometry {
-    /// [`WheelsetGeometry::table`], shared within the process: a geometry tabulated before
-    /// (bit for bit the same profiles, radius, gauge and flange back) gets the same table back
-    /// instead of building it again (about 1.4 s on two cores). A table is a function of its
-    /// geometry alone, so the runs' bytes do not change.
-    pub fn shared_table(&self, y_max: f64, dy: f64) -> Arc<ContactTable> {
-        let mut key = vec![
-            y_max.to_bits(),
-            dy.to_bits(),
-            self.nominal_radius.to_bits(),
-            self.tape_circle_half.to_bits(),
-            self.half_gauge.to_bits(),
-            self.flange_back.to_bits(),
-        ];
-        self.wheel().fingerprint(&mut key);
-        self.rail().fingerprint(&mut key);
-        // Held while building: two runs needing the same new table build it once (the build
-        // itself uses every core).
-        let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, t)) = built.iter().find(|(k, _)| *k == key) {
-            return t.clone();
-        }
-        // On disk across processes: a run's first result need not wait for the build.
-        let table = Arc::new(super::table_cache::load_or_build(&key, || {
-            self.table(y_max, dy)
-        }));
-        if built.len() == KEPT {
-            built.remove(0);
-        }
-        built.push((key, table.clone()));
-        table
-    }
-
     /// Precomputes contact states over `y ∈ [−y_max, y_max]` every `dy` at zero yaw, on all
     /// cores (each shift is solved on its own, so the result does not depend on the threads).
     pub fn table(&self, y_max: f64, dy: f64) -> ContactTable {
