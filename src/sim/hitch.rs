@@ -390,14 +390,21 @@ impl TrainSetup {
             }
             return Ok(None);
         }
-        let consist = match BUILTIN_CONSISTS.iter().find(|(n, _)| *n == spec) {
+        // A file that exists is used as given (as vehicle and track files are); else a
+        // built-in name.
+        let file = base.join(spec);
+        let builtin = BUILTIN_CONSISTS
+            .iter()
+            .find(|(n, _)| *n == spec)
+            .filter(|_| !file.is_file());
+        let consist = match builtin {
             Some((name, text)) => Consist::parse(
                 text,
                 std::path::Path::new(&format!("vehicles/{name}.consist.toml")),
             )?,
             None => {
-                let path = base.join(spec);
-                if !path.exists() {
+                let path = file;
+                if !path.is_file() {
                     return Err(crate::error::Error::Domain(format!(
                         "{field} = \"{spec}\": neither a built-in consist ({}) nor a file ({}); `{ALONE}` runs the wagon alone",
                         BUILTIN_CONSISTS
