@@ -194,3 +194,60 @@ fn assess_reports_the_coupler_force_of_a_run_in_a_train() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A plan mixing a wagon alone and a wagon in a train makes one data set with one set of
+/// channels: the run alone records the couplers as zeros (it has none), the other its forces.
+#[test]
+fn a_plan_mixing_trains_and_wagons_alone_records_one_set_of_channels() {
+    let dir = std::env::temp_dir().join(format!("railforce-mixed-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let plan = dir.join("mixed.plan.toml");
+    std::fs::write(
+        &plan,
+        format!(
+            "name = \"mixed\"\nvehicle = \"{v}\"\nduration_s = 0.5\nseeds = [1]\n\
+             [[condition]]\nname = \"alone\"\ntrack = \"{t}\"\nspeed_kmh = 60.0\n\
+             [[condition]]\nname = \"train\"\ntrack = \"{t}\"\nspeed_kmh = 60.0\nconsist = \"daqin_10kt\"\nposition = 0.5\n",
+            v = root().join("vehicles/c80.toml").display(),
+            t = root().join("tracks/tangent.toml").display()
+        ),
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+        .args(["generate", "--plan"])
+        .arg(&plan)
+        .arg("--out")
+        .arg(dir.join("data"))
+        .args(["--format", "csv", "--settle", "0.5"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let col = |file: &str, name: &str| -> Vec<f64> {
+        let text = std::fs::read_to_string(dir.join("data").join(file)).unwrap();
+        let mut lines = text.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let k = head
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("{file}: no {name}"));
+        lines
+            .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+            .collect()
+    };
+    assert!(
+        col("alone_seed1.csv", "coupler_front_force")
+            .iter()
+            .all(|&f| f == 0.0)
+    );
+    assert!(
+        col("train_seed1.csv", "coupler_front_force")
+            .iter()
+            .all(|&f| f > 0.0)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

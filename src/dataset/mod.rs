@@ -361,6 +361,9 @@ pub fn generate(
             settle: opts.settle,
             start: run.condition.start_m,
             train: run.condition.train.clone(),
+            // One set of channels in a data set: every run records the couplers when any
+            // condition runs in a train.
+            coupler_channels: plan.conditions.iter().any(|c| c.train.is_some()),
             dt: opts.stepping.dt,
             integrator: opts.stepping.integrator,
             // A derailment risk (Nadal's limit held 50 ms) is reported and the run kept: a

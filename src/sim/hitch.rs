@@ -470,6 +470,12 @@ impl super::Simulation<'_> {
         );
     }
 
+    /// Whether the run records the couplers' channels: in a train, or asked to
+    /// ([`super::SimConfig::coupler_channels`]).
+    pub fn records_couplers(&self) -> bool {
+        self.hitch.is_some() || self.cfg.coupler_channels
+    }
+
     /// The train the run's carbody is coupled into, if any.
     pub fn hitch(&self) -> Option<&Hitch> {
         self.hitch.as_deref()

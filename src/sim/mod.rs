@@ -87,6 +87,9 @@ pub struct SimConfig {
     /// The train around the wagon (None: the wagon alone, its speed held by the vehicle
     /// file's `[hauling]` control).
     pub train: Option<hitch::TrainSetup>,
+    /// Record the couplers' channels even for a wagon alone (zeros: it has no coupler), so
+    /// a data set mixing runs alone and in a train has one set of channels.
+    pub coupler_channels: bool,
 }
 
 impl Default for SimConfig {
@@ -109,6 +112,7 @@ impl Default for SimConfig {
             initial_offset: 0.0,
             integrator: Integrator::default(),
             train: None,
+            coupler_channels: false,
         }
     }
 }

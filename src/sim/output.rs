@@ -46,7 +46,7 @@ impl Recorder {
         let v = sim.vehicle();
         let paper = v.sensors.is_some();
         let (names, units): (Vec<String>, Vec<&'static str>) =
-            super::channels::channels_of(v, sim.hitch().is_some())
+            super::channels::channels_of(v, sim.records_couplers())
                 .into_iter()
                 .map(|c| (c.name, c.unit))
                 .unzip();
@@ -246,8 +246,9 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
     }
     // What the wagon weighs (a weighbridge, or the consist list): known, not sensed.
     put(v.mass() * 1e-3);
-    if let Some(h) = sim.hitch() {
-        let [f, r] = h.readings;
+    if sim.records_couplers() {
+        // A wagon alone in a data set of trains: no coupler, no force, no angle.
+        let [f, r] = sim.hitch().map(|h| h.readings).unwrap_or_default();
         for x in [f.force, r.force, f.yaw, r.yaw] {
             put(x);
         }
