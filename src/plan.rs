@@ -366,6 +366,8 @@ impl Plan {
                     track: &c.track,
                     speed_kmh: c.speed_kmh,
                     class: c.class,
+                    consist: c.train.as_ref().map(|t| &t.consist),
+                    position: c.train.as_ref().and_then(|t| t.position),
                 },
                 &c.vary,
                 &mut tried,

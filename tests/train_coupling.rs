@@ -251,3 +251,63 @@ fn a_plan_mixing_trains_and_wagons_alone_records_one_set_of_channels() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A fleet may draw the wagon's place in its train (`[vary] position`): each run records the
+/// drawn place; drawn for a condition in no train, the plan is refused naming the key.
+#[test]
+fn a_plan_draws_the_wagons_place_in_its_train() {
+    let dir = std::env::temp_dir().join(format!("railforce-varypos-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let plan = |consist: &str| {
+        format!(
+            "name = \"v\"\nvehicle = \"{v}\"\nduration_s = 0.3\nseeds = [1, 2, 3]\n{consist}\
+             [vary]\nposition = {{ uniform = [0.1, 0.9] }}\n\
+             [[condition]]\nname = \"c\"\ntrack = \"{t}\"\nspeed_kmh = 60.0\n",
+            v = root().join("vehicles/c80.toml").display(),
+            t = root().join("tracks/tangent.toml").display()
+        )
+    };
+    let generate = |text: String| {
+        let p = dir.join("v.plan.toml");
+        std::fs::write(&p, text).unwrap();
+        let _ = std::fs::remove_dir_all(dir.join("data"));
+        std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .args(["generate", "--plan"])
+            .arg(&p)
+            .arg("--out")
+            .arg(dir.join("data"))
+            .args(["--settle", "0.2"])
+            .output()
+            .unwrap()
+    };
+    let out = generate(plan("consist = \"daqin_10kt\"\n"));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("data/manifest.json")).unwrap())
+            .unwrap();
+    let places: Vec<f64> = m["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["position"].as_f64().unwrap())
+        .collect();
+    assert_eq!(places.len(), 3);
+    assert!(places.iter().all(|p| (0.1..=0.9).contains(p)), "{places:?}");
+    assert!(
+        places[0] != places[1] && places[1] != places[2],
+        "{places:?}"
+    );
+    let out = generate(plan(""));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("vary.\"position\"") && err.contains("no train"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

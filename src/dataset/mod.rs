@@ -355,12 +355,25 @@ pub fn generate(
         };
         let vehicle = drawn_vehicle.as_ref().unwrap_or(shared);
         let track = Track::new(spec.clone(), Some(run.realisation_seed()));
+        // The wagon's place in its train, drawn or the condition's.
+        let at =
+            |e: Error| Error::Domain(format!("{} (seed {}): {e}", run.condition.name, run.seed));
+        let train = match &run.condition.train {
+            Some(t) => Some(crate::sim::hitch::TrainSetup {
+                consist: t.consist.clone(),
+                position: crate::vary::position(t.position, draws, Some(&t.consist)).map_err(at)?,
+            }),
+            None => {
+                crate::vary::position(None, draws, None).map_err(at)?;
+                None
+            }
+        };
         let cfg = SimConfig {
             speed: speed_kmh / 3.6,
             duration: run.condition.duration,
             settle: opts.settle,
             start: run.condition.start_m,
-            train: run.condition.train.clone(),
+            train: train.clone(),
             // One set of channels in a data set: every run records the couplers when any
             // condition runs in a train.
             coupler_channels: plan.conditions.iter().any(|c| c.train.is_some()),
@@ -401,7 +414,7 @@ pub fn generate(
             class: run.condition.class,
             start_m: run.condition.start_m,
             consist: run.condition.consist.clone(),
-            position: run.condition.train.as_ref().and_then(|t| t.position),
+            position: train.as_ref().and_then(|t| t.position),
             rows: rec.rows.len(),
             peak_y_over_q: rec.summary.peak_y_over_q,
             draws: crate::vary::to_json(draws),

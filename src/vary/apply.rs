@@ -53,6 +53,35 @@ pub fn speed_kmh(base: f64, draws: &Draws) -> Result<f64> {
     }
 }
 
+/// The wagon's place in its train for a run: the condition's `base` (None: the consist
+/// file's own), or the drawn `position` (a fraction of the train's length from the head;
+/// scaled, a factor on the base), checked to land on a wagon of `consist`. Drawn for a
+/// condition in no train, an error.
+pub fn position(
+    base: Option<f64>,
+    draws: &Draws,
+    consist: Option<&crate::train::Consist>,
+) -> Result<Option<f64>> {
+    let Some(d) = draws.get("position") else {
+        return Ok(base);
+    };
+    let Some(consist) = consist else {
+        return Err(Error::Domain(
+            "position: drawn for a condition in no train: give it a consist".into(),
+        ));
+    };
+    let x = number(&d.value).map_err(Error::Domain)?;
+    let p = if d.scale {
+        base.unwrap_or(consist.position) * x
+    } else {
+        x
+    };
+    consist
+        .index_at(p)
+        .map_err(|e| Error::Domain(format!("position: {p}: {e}")))?;
+    Ok(Some(p))
+}
+
 /// A condition as [`check`] sees it.
 #[derive(Debug, Clone, Copy)]
 pub struct Subject<'a> {
@@ -68,6 +97,10 @@ pub struct Subject<'a> {
     pub speed_kmh: f64,
     /// The FRA class it sets, if any.
     pub class: Option<i64>,
+    /// Its train's consist and the wagon's place in it, if it runs in one.
+    pub consist: Option<&'a crate::train::Consist>,
+    /// See `consist`.
+    pub position: Option<f64>,
 }
 
 /// Tries every variation of a condition at the ends of its range (each value of a list), one
@@ -108,10 +141,10 @@ pub fn check(
                 let file = match t {
                     Target::Vehicle | Target::Body => c.vehicle,
                     Target::Track => c.track,
-                    Target::Speed => source,
+                    Target::Speed | Target::Position => source,
                 };
                 let id = (file.to_path_buf(), key.clone(), value.to_string());
-                if t != Target::Speed && tried.contains(&id) {
+                if !matches!(t, Target::Speed | Target::Position) && tried.contains(&id) {
                     continue;
                 }
                 let only: Draws = [(key.clone(), d.clone())].into_iter().collect();
@@ -119,6 +152,7 @@ pub fn check(
                     Target::Vehicle | Target::Body => vehicle_for(file, &only).map(|_| ()),
                     Target::Track => track_for(file, &only).map(|_| ()),
                     Target::Speed => speed_kmh(c.speed_kmh, &only).map(|_| ()),
+                    Target::Position => position(c.position, &only, c.consist).map(|_| ()),
                 };
                 if let Err(e) = outcome {
                     return Err(Error::config(

@@ -27,7 +27,7 @@
 
 mod apply;
 
-pub use apply::{Subject, check, speed_kmh, track_for, vehicle_for};
+pub use apply::{Subject, check, position, speed_kmh, track_for, vehicle_for};
 
 use crate::error::{Error, Result};
 use rand_chacha::ChaCha8Rng;
@@ -131,6 +131,8 @@ pub enum Target {
     Track,
     /// The condition's speed.
     Speed,
+    /// The wagon's place in the condition's train.
+    Position,
 }
 
 /// Where `key` points, or why it cannot.
@@ -138,6 +140,7 @@ pub fn target(key: &str) -> std::result::Result<Target, String> {
     let first = key.split('.').next().unwrap_or_default();
     match first {
         "speed_kmh" if key == "speed_kmh" => Ok(Target::Speed),
+        "position" if key == "position" => Ok(Target::Position),
         "vehicle" if key.starts_with("vehicle.body.") => Ok(Target::Body),
         "vehicle" | "track" if key.len() > first.len() + 1 => Ok(if first == "vehicle" {
             Target::Vehicle
@@ -145,7 +148,7 @@ pub fn target(key: &str) -> std::result::Result<Target, String> {
             Target::Track
         }),
         _ => Err(format!(
-            "\"{key}\": a key starts with vehicle. (a key of the vehicle file, or vehicle.body.<link>.mass / inertia / z), track. (a key of the track file) or is speed_kmh"
+            "\"{key}\": a key starts with vehicle. (a key of the vehicle file, or vehicle.body.<link>.mass / inertia / z), track. (a key of the track file) or is speed_kmh or position (the wagon's place in its train)"
         )),
     }
 }
