@@ -252,17 +252,23 @@ fn a_plan_mixing_trains_and_wagons_alone_records_one_set_of_channels() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A fleet may draw the wagon's place in its train (`[vary] position`): each run records the
-/// drawn place; drawn for a condition in no train, the plan is refused naming the key.
+/// A fleet may draw the wagon's place in its train (`[vary] position`) and the mass of its
+/// train's wagons (`consist_mass`, a factor): each run records its draws; drawn for a
+/// condition in no train, the plan is refused naming the key.
 #[test]
 fn a_plan_draws_the_wagons_place_in_its_train() {
     let dir = std::env::temp_dir().join(format!("railforce-varypos-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let plan = |consist: &str| {
+        let mass = if consist.is_empty() {
+            ""
+        } else {
+            "consist_mass = { uniform = [0.6, 1.0], scale = true }\n"
+        };
         format!(
             "name = \"v\"\nvehicle = \"{v}\"\nduration_s = 0.3\nseeds = [1, 2, 3]\n{consist}\
-             [vary]\nposition = {{ uniform = [0.1, 0.9] }}\n\
+             [vary]\nposition = {{ uniform = [0.1, 0.9] }}\n{mass}\
              [[condition]]\nname = \"c\"\ntrack = \"{t}\"\nspeed_kmh = 60.0\n",
             v = root().join("vehicles/c80.toml").display(),
             t = root().join("tracks/tangent.toml").display()
@@ -302,6 +308,12 @@ fn a_plan_draws_the_wagons_place_in_its_train() {
         places[0] != places[1] && places[1] != places[2],
         "{places:?}"
     );
+    for r in m["runs"].as_array().unwrap() {
+        let f = r["draws"]["consist_mass"]["scale"]
+            .as_f64()
+            .unwrap_or(f64::NAN);
+        assert!((0.6..=1.0).contains(&f), "{}", r["draws"]);
+    }
     let out = generate(plan(""));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());

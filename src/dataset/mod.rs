@@ -360,11 +360,14 @@ pub fn generate(
             |e: Error| Error::Domain(format!("{} (seed {}): {e}", run.condition.name, run.seed));
         let train = match &run.condition.train {
             Some(t) => Some(crate::sim::hitch::TrainSetup {
-                consist: t.consist.clone(),
+                consist: crate::vary::consist_for(Some(&t.consist), draws)
+                    .map_err(at)?
+                    .unwrap_or_else(|| t.consist.clone()),
                 position: crate::vary::position(t.position, draws, Some(&t.consist)).map_err(at)?,
             }),
             None => {
                 crate::vary::position(None, draws, None).map_err(at)?;
+                crate::vary::consist_for(None, draws).map_err(at)?;
                 None
             }
         };

@@ -82,6 +82,39 @@ pub fn position(
     Ok(Some(p))
 }
 
+/// The condition's consist with the drawn `consist_mass` applied: every wagon's mass times
+/// the drawn factor (the locomotives keep theirs; the 3-D wagon's own mass is its vehicle
+/// file's). The factor must be drawn scaled and lie in (0, 2]; drawn for a condition in no
+/// train, an error.
+pub fn consist_for(
+    consist: Option<&crate::train::Consist>,
+    draws: &Draws,
+) -> Result<Option<crate::train::Consist>> {
+    let Some(d) = draws.get("consist_mass") else {
+        return Ok(consist.cloned());
+    };
+    let Some(consist) = consist else {
+        return Err(Error::Domain(
+            "consist_mass: drawn for a condition in no train: give it a consist".into(),
+        ));
+    };
+    let f = number(&d.value).map_err(Error::Domain)?;
+    if !(d.scale && f > 0.0 && f <= 2.0) {
+        return Err(Error::Domain(format!(
+            "consist_mass: a factor in (0, 2] on the wagons' masses, drawn with scale = true (got {f})"
+        )));
+    }
+    let mut c = consist.clone();
+    for v in c
+        .vehicles
+        .iter_mut()
+        .filter(|v| v.kind == crate::train::VehicleKind::Wagon)
+    {
+        v.mass *= f;
+    }
+    Ok(Some(c))
+}
+
 /// A condition as [`check`] sees it.
 #[derive(Debug, Clone, Copy)]
 pub struct Subject<'a> {
@@ -141,10 +174,12 @@ pub fn check(
                 let file = match t {
                     Target::Vehicle | Target::Body => c.vehicle,
                     Target::Track => c.track,
-                    Target::Speed | Target::Position => source,
+                    Target::Speed | Target::Position | Target::ConsistMass => source,
                 };
                 let id = (file.to_path_buf(), key.clone(), value.to_string());
-                if !matches!(t, Target::Speed | Target::Position) && tried.contains(&id) {
+                if matches!(t, Target::Vehicle | Target::Body | Target::Track)
+                    && tried.contains(&id)
+                {
                     continue;
                 }
                 let only: Draws = [(key.clone(), d.clone())].into_iter().collect();
@@ -153,6 +188,7 @@ pub fn check(
                     Target::Track => track_for(file, &only).map(|_| ()),
                     Target::Speed => speed_kmh(c.speed_kmh, &only).map(|_| ()),
                     Target::Position => position(c.position, &only, c.consist).map(|_| ()),
+                    Target::ConsistMass => consist_for(c.consist, &only).map(|_| ()),
                 };
                 if let Err(e) = outcome {
                     return Err(Error::config(

@@ -27,7 +27,7 @@
 
 mod apply;
 
-pub use apply::{Subject, check, position, speed_kmh, track_for, vehicle_for};
+pub use apply::{Subject, check, consist_for, position, speed_kmh, track_for, vehicle_for};
 
 use crate::error::{Error, Result};
 use rand_chacha::ChaCha8Rng;
@@ -133,6 +133,8 @@ pub enum Target {
     Speed,
     /// The wagon's place in the condition's train.
     Position,
+    /// The mass of the wagons of the condition's train (a factor).
+    ConsistMass,
 }
 
 /// Where `key` points, or why it cannot.
@@ -141,6 +143,7 @@ pub fn target(key: &str) -> std::result::Result<Target, String> {
     match first {
         "speed_kmh" if key == "speed_kmh" => Ok(Target::Speed),
         "position" if key == "position" => Ok(Target::Position),
+        "consist_mass" if key == "consist_mass" => Ok(Target::ConsistMass),
         "vehicle" if key.starts_with("vehicle.body.") => Ok(Target::Body),
         "vehicle" | "track" if key.len() > first.len() + 1 => Ok(if first == "vehicle" {
             Target::Vehicle
@@ -148,7 +151,7 @@ pub fn target(key: &str) -> std::result::Result<Target, String> {
             Target::Track
         }),
         _ => Err(format!(
-            "\"{key}\": a key starts with vehicle. (a key of the vehicle file, or vehicle.body.<link>.mass / inertia / z), track. (a key of the track file) or is speed_kmh or position (the wagon's place in its train)"
+            "\"{key}\": a key starts with vehicle. (a key of the vehicle file, or vehicle.body.<link>.mass / inertia / z), track. (a key of the track file) or is speed_kmh, position (the wagon's place in its train) or consist_mass (a factor on its train's wagons' masses)"
         )),
     }
 }
