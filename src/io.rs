@@ -310,46 +310,27 @@ mod finite {
             v.serialize(self.at.key(k))
         }
     }
-    impl ser::SerializeSeq for Seq {
-        type Ok = ();
-        type Error = Bad;
-        fn serialize_element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Bad> {
-            self.element(v)
-        }
-        fn end(self) -> Result<(), Bad> {
-            Ok(())
-        }
+    /// The compound walks whose items are positional: each is an element of the field.
+    macro_rules! positional {
+        ($($trait:ident :: $method:ident),*) => {$(
+            impl ser::$trait for Seq {
+                type Ok = ();
+                type Error = Bad;
+                fn $method<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Bad> {
+                    self.element(v)
+                }
+                fn end(self) -> Result<(), Bad> {
+                    Ok(())
+                }
+            }
+        )*};
     }
-    impl ser::SerializeTuple for Seq {
-        type Ok = ();
-        type Error = Bad;
-        fn serialize_element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Bad> {
-            self.element(v)
-        }
-        fn end(self) -> Result<(), Bad> {
-            Ok(())
-        }
-    }
-    impl ser::SerializeTupleStruct for Seq {
-        type Ok = ();
-        type Error = Bad;
-        fn serialize_field<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Bad> {
-            self.element(v)
-        }
-        fn end(self) -> Result<(), Bad> {
-            Ok(())
-        }
-    }
-    impl ser::SerializeTupleVariant for Seq {
-        type Ok = ();
-        type Error = Bad;
-        fn serialize_field<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Bad> {
-            self.element(v)
-        }
-        fn end(self) -> Result<(), Bad> {
-            Ok(())
-        }
-    }
+    positional!(
+        SerializeSeq::serialize_element,
+        SerializeTuple::serialize_element,
+        SerializeTupleStruct::serialize_field,
+        SerializeTupleVariant::serialize_field
+    );
     impl ser::SerializeMap for Seq {
         type Ok = ();
         type Error = Bad;
@@ -370,34 +351,26 @@ mod finite {
             Ok(())
         }
     }
-    impl ser::SerializeStruct for Seq {
-        type Ok = ();
-        type Error = Bad;
-        fn serialize_field<T: Serialize + ?Sized>(
-            &mut self,
-            k: &'static str,
-            v: &T,
-        ) -> Result<(), Bad> {
-            self.field(k, v)
-        }
-        fn end(self) -> Result<(), Bad> {
-            Ok(())
-        }
+    /// The compound walks whose items are named fields.
+    macro_rules! named {
+        ($($trait:ident),*) => {$(
+            impl ser::$trait for Seq {
+                type Ok = ();
+                type Error = Bad;
+                fn serialize_field<T: Serialize + ?Sized>(
+                    &mut self,
+                    k: &'static str,
+                    v: &T,
+                ) -> Result<(), Bad> {
+                    self.field(k, v)
+                }
+                fn end(self) -> Result<(), Bad> {
+                    Ok(())
+                }
+            }
+        )*};
     }
-    impl ser::SerializeStructVariant for Seq {
-        type Ok = ();
-        type Error = Bad;
-        fn serialize_field<T: Serialize + ?Sized>(
-            &mut self,
-            k: &'static str,
-            v: &T,
-        ) -> Result<(), Bad> {
-            self.field(k, v)
-        }
-        fn end(self) -> Result<(), Bad> {
-            Ok(())
-        }
-    }
+    named!(SerializeStruct, SerializeStructVariant);
 }
 
 #[cfg(test)]

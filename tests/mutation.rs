@@ -283,39 +283,10 @@ fn model_and_data_set_files_parse_or_say_why() {
     let dir = std::env::temp_dir().join(format!("railforce-mut-md-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let root = env!("CARGO_MANIFEST_DIR");
-    let plan = dir.join("p.plan.toml");
-    std::fs::write(
-        &plan,
-        format!(
-            "name = \"p\"\nvehicle = \"{root}/vehicles/c80.toml\"\nduration_s = 0.4\nseeds = [1, 2, 3]\n\
-             [[condition]]\nname = \"tangent\"\ntrack = \"{root}/tracks/tangent.toml\"\nspeed_kmh = 60.0\n"
-        ),
-    )
-    .unwrap();
+    let (plan, data, model) = common::tiny_data_and_tree_model(&dir);
     let run = |args: &[&str]| {
         common::succeed(std::process::Command::new(env!("CARGO_BIN_EXE_railforce")).args(args));
     };
-    let data = dir.join("data");
-    let model = dir.join("model");
-    run(&[
-        "generate",
-        "--plan",
-        plan.to_str().unwrap(),
-        "--out",
-        data.to_str().unwrap(),
-        "--settle",
-        "0.1",
-    ]);
-    run(&[
-        "train",
-        "--data",
-        data.to_str().unwrap(),
-        "--model",
-        "tree",
-        "--out",
-        model.to_str().unwrap(),
-    ]);
     fuzz(
         "model",
         &model.join("model.json"),

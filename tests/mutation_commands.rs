@@ -18,10 +18,7 @@ fn root() -> PathBuf {
 }
 
 fn scratch(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("railforce-mutcmd-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch(&format!("mutcmd-{tag}"))
 }
 
 fn railforce(dir: &Path) -> Command {
@@ -176,37 +173,7 @@ fn made() -> &'static Made {
             "--out",
             run_csv.to_str().unwrap(),
         ]));
-        let plan = dir.join("p.plan.toml");
-        std::fs::write(
-            &plan,
-            format!(
-                "name = \"p\"\nvehicle = \"{}\"\nduration_s = 0.4\nseeds = [1, 2, 3]\n\
-                 [[condition]]\nname = \"tangent\"\ntrack = \"{}\"\nspeed_kmh = 60.0\n",
-                r.join("vehicles/c80.toml").display(),
-                r.join("tracks/tangent.toml").display()
-            ),
-        )
-        .unwrap();
-        let data = dir.join("data");
-        let model = dir.join("model");
-        common::succeed(railforce(&dir).args([
-            "generate",
-            "--plan",
-            plan.to_str().unwrap(),
-            "--out",
-            data.to_str().unwrap(),
-            "--settle",
-            "0.1",
-        ]));
-        common::succeed(railforce(&dir).args([
-            "train",
-            "--data",
-            data.to_str().unwrap(),
-            "--model",
-            "tree",
-            "--out",
-            model.to_str().unwrap(),
-        ]));
+        let (_, _, model) = common::tiny_data_and_tree_model(&dir);
         Made {
             dir,
             run_csv,

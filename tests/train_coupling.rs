@@ -74,8 +74,7 @@ fn couplers_swing_inward_by_the_closed_form_in_a_steady_curve() {
 /// refused by `simulate`, naming the file and the field.
 #[test]
 fn bad_consists_are_refused_naming_file_and_field() {
-    let dir = std::env::temp_dir().join(format!("railforce-consist-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::scratch("consist");
     let good = std::fs::read_to_string(root().join("vehicles/daqin_10kt.consist.toml")).unwrap();
     let cases: Vec<(String, Vec<&str>, &str)> = vec![
         (good.clone(), vec!["--position", "1.5"], "position"),
@@ -128,54 +127,34 @@ fn bad_consists_are_refused_naming_file_and_field() {
 /// couplers for a wagon alone.
 #[test]
 fn assess_reports_the_coupler_force_of_a_run_in_a_train() {
-    let dir = std::env::temp_dir().join(format!("railforce-assess-train-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::scratch("assess-train");
     let bin = env!("CARGO_BIN_EXE_railforce");
     let track = root().join("tracks/curve_r800.toml");
     for (consist, want) in [("daqin_10kt", true), ("none", false)] {
         let run = dir.join(format!("{consist}.csv"));
-        let out = std::process::Command::new(bin)
-            .args([
-                "simulate",
-                "--duration",
-                "8",
-                "--consist",
-                consist,
-                "--track",
-            ])
-            .arg(&track)
-            .arg("--out")
-            .arg(&run)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        crate::common::succeed(
+            std::process::Command::new(bin)
+                .args([
+                    "simulate",
+                    "--duration",
+                    "8",
+                    "--consist",
+                    consist,
+                    "--track",
+                ])
+                .arg(&track)
+                .arg("--out")
+                .arg(&run),
         );
         let adir = dir.join(format!("a_{consist}"));
-        let out = std::process::Command::new(bin)
-            .arg("assess")
-            .arg(&run)
-            .arg("--out")
-            .arg(&adir)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        crate::common::succeed(
+            std::process::Command::new(bin)
+                .arg("assess")
+                .arg(&run)
+                .arg("--out")
+                .arg(&adir),
         );
-        let out = std::process::Command::new(bin)
-            .arg("view")
-            .arg(&run)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        crate::common::succeed(std::process::Command::new(bin).arg("view").arg(&run));
         let html = std::fs::read_to_string(run.with_extension("view.html")).unwrap();
         assert_eq!(html.contains("\"couplers\":{\"force\""), want);
         let csv = std::fs::read_to_string(adir.join("assessment.csv")).unwrap();
@@ -199,9 +178,7 @@ fn assess_reports_the_coupler_force_of_a_run_in_a_train() {
 /// channels: the run alone records the couplers as zeros (it has none), the other its forces.
 #[test]
 fn a_plan_mixing_trains_and_wagons_alone_records_one_set_of_channels() {
-    let dir = std::env::temp_dir().join(format!("railforce-mixed-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::scratch("mixed");
     let plan = dir.join("mixed.plan.toml");
     std::fs::write(
         &plan,
@@ -214,18 +191,13 @@ fn a_plan_mixing_trains_and_wagons_alone_records_one_set_of_channels() {
         ),
     )
     .unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
-        .args(["generate", "--plan"])
-        .arg(&plan)
-        .arg("--out")
-        .arg(dir.join("data"))
-        .args(["--format", "csv", "--settle", "0.5"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    crate::common::succeed(
+        std::process::Command::new(env!("CARGO_BIN_EXE_railforce"))
+            .args(["generate", "--plan"])
+            .arg(&plan)
+            .arg("--out")
+            .arg(dir.join("data"))
+            .args(["--format", "csv", "--settle", "0.5"]),
     );
     let col = |file: &str, name: &str| -> Vec<f64> {
         let text = std::fs::read_to_string(dir.join("data").join(file)).unwrap();
@@ -257,9 +229,7 @@ fn a_plan_mixing_trains_and_wagons_alone_records_one_set_of_channels() {
 /// condition in no train, the plan is refused naming the key.
 #[test]
 fn a_plan_draws_the_wagons_place_in_its_train() {
-    let dir = std::env::temp_dir().join(format!("railforce-varypos-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::scratch("varypos");
     let plan = |consist: &str| {
         let mass = if consist.is_empty() {
             ""

@@ -26,6 +26,7 @@ pub mod output;
 pub mod profile;
 mod request;
 mod track_frame;
+mod watch;
 mod wheel_rail;
 mod wheelset_solve;
 
@@ -542,101 +543,6 @@ impl<'a> Simulation<'a> {
             }
             self.frames_step = self.step_count;
         }
-    }
-
-    /// Non-finite states, runaway motion, derailment.
-    fn check(&mut self) -> Result<()> {
-        self.step_count += 1;
-        // A non-finite state, every step and before anything looks the track up with it: a
-        // NaN position must end the run with its name, not reach a grid lookup. One sum
-        // carries any NaN or infinity of the state (inf − inf is NaN too).
-        let sum: f64 = self
-            .states
-            .iter()
-            .map(|st| {
-                st.position.sum()
-                    + st.velocity.sum()
-                    + st.angular_velocity.sum()
-                    + st.rotation.coords.sum()
-            })
-            .sum();
-        if !sum.is_finite() {
-            for (i, st) in self.states.iter().enumerate() {
-                let finite = st.position.iter().all(|v| v.is_finite())
-                    && st.velocity.iter().all(|v| v.is_finite())
-                    && st.angular_velocity.iter().all(|v| v.is_finite())
-                    && st.rotation.coords.iter().all(|v| v.is_finite());
-                if !finite {
-                    return Err(Error::Domain(format!(
-                        "simulation diverged at t = {:.4} s: body '{}' has a non-finite state",
-                        self.time, self.vehicle.bodies[i].name
-                    )));
-                }
-            }
-            return Err(Error::Domain(format!(
-                "simulation diverged at t = {:.4} s: the state grew beyond floating point",
-                self.time
-            )));
-        }
-        // Whole-state checks every 100 steps (10 ms at the default step); wheels every step.
-        let full = self.step_count.is_multiple_of(100);
-        if full {
-            self.refresh_frames();
-        }
-        for (i, st) in self.states.iter().enumerate().filter(|_| full) {
-            let rel_v = st.velocity - self.frames[i].axes.column(0) * self.cfg.speed;
-            let name = &self.vehicle.bodies[i].name;
-            if rel_v.norm() > self.cfg.runaway_speed {
-                return Err(Error::Domain(format!(
-                    "simulation diverged at t = {:.4} s: body '{name}' moves {:.1} m/s away from the running motion (runaway energy)",
-                    self.time,
-                    rel_v.norm()
-                )));
-            }
-        }
-        let limit = self.nadal_limit;
-        let flange = self.flange_height;
-        for k in 0..self.wheels.len() {
-            let w = &self.wheels[k];
-            let name = || wheel_name(k);
-            // Climb: how far the wheel has risen on its flange (contact radius above the tape
-            // circle) plus any gap; derailed at 90 % of the flange height (the tip is rounded).
-            if w.climb > self.cfg.climb_limit * flange || w.y_rel.abs() > self.cfg.lateral_limit {
-                let msg = format!(
-                    "derailment at t = {:.3} s, s = {:.1} m: wheel {} climbed {:.1} mm of its {:.1} mm flange (lateral shift {:.1} mm relative to its rail)",
-                    self.time,
-                    w.s,
-                    name(),
-                    w.climb * 1e3,
-                    flange * 1e3,
-                    w.y_rel * 1e3
-                );
-                if self.cfg.stop_on_derailment {
-                    return Err(Error::Domain(msg));
-                }
-                eprintln!("warning: {msg}");
-            }
-            if w.q > 1.0 && (w.y / w.q).abs() > limit {
-                self.over_nadal[k] += self.cfg.dt;
-            } else {
-                self.over_nadal[k] = 0.0;
-            }
-            if self.over_nadal[k] > self.cfg.nadal_time {
-                let msg = format!(
-                    "derailment risk at t = {:.3} s, s = {:.1} m: wheel {} has |Y/Q| above the Nadal limit {limit:.3} for more than {:.0} ms",
-                    self.time,
-                    w.s,
-                    name(),
-                    self.cfg.nadal_time * 1e3
-                );
-                if self.cfg.stop_on_derailment && self.cfg.stop_on_derailment_risk {
-                    return Err(Error::Domain(msg));
-                }
-                eprintln!("warning: {msg}; the run goes on");
-                self.over_nadal[k] = f64::NEG_INFINITY;
-            }
-        }
-        Ok(())
     }
 
     /// Runs the settling phase (not recorded).

@@ -15,6 +15,14 @@ pub fn succeed(cmd: &mut Command) -> Output {
     out
 }
 
+/// An empty scratch folder `railforce-TAG-PID` under the system's temporary directory.
+pub fn scratch(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("railforce-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// The railforce binary under test, started in `dir`.
 pub fn railforce_in(dir: &std::path::Path) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_railforce"));
@@ -64,4 +72,44 @@ pub fn load_c80_edited(edit: impl Fn(String) -> String) -> String {
         Ok(_) => "loaded".into(),
         Err(e) => e.to_string(),
     }
+}
+
+/// A tiny data set (the C80 on tangent track at 60 km/h, 0.4 s, seeds 1–3) and a tree
+/// model trained on it, made with the binary in `dir`: `(plan, data, model)`.
+pub fn tiny_data_and_tree_model(
+    dir: &std::path::Path,
+) -> (std::path::PathBuf, std::path::PathBuf, std::path::PathBuf) {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let plan = dir.join("p.plan.toml");
+    std::fs::write(
+        &plan,
+        format!(
+            "name = \"p\"\nvehicle = \"{root}/vehicles/c80.toml\"\nduration_s = 0.4\nseeds = [1, 2, 3]\n\
+             [[condition]]\nname = \"tangent\"\ntrack = \"{root}/tracks/tangent.toml\"\nspeed_kmh = 60.0\n"
+        ),
+    )
+    .unwrap();
+    let (data, model) = (dir.join("data"), dir.join("model"));
+    let run = |args: &[&str]| {
+        succeed(Command::new(env!("CARGO_BIN_EXE_railforce")).args(args));
+    };
+    run(&[
+        "generate",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--out",
+        data.to_str().unwrap(),
+        "--settle",
+        "0.1",
+    ]);
+    run(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        "tree",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    (plan, data, model)
 }
