@@ -16,6 +16,10 @@ pub const FILES: &[(&str, &str)] = &[
     ("vehicles/assessment.toml", crate::assess::criteria::DEFAULT),
     ("vehicles/c80.toml", include_str!("../vehicles/c80.toml")),
     (
+        "vehicles/c80.estimates.toml",
+        include_str!("../vehicles/c80.estimates.toml"),
+    ),
+    (
         "vehicles/daqin_10kt.consist.toml",
         crate::sim::hitch::BUILTIN_CONSISTS[0].1,
     ),
@@ -159,6 +163,10 @@ pub const FILES: &[(&str, &str)] = &[
     (
         "tracks/paper34_varied.plan.toml",
         include_str!("../tracks/paper34_varied.plan.toml"),
+    ),
+    (
+        "tracks/sensitivity.plan.toml",
+        include_str!("../tracks/sensitivity.plan.toml"),
     ),
     (
         "tracks/tangent.toml",

@@ -26,6 +26,7 @@ pub mod plan;
 #[cfg(feature = "python")]
 mod python;
 pub mod report;
+pub mod sensitivity;
 pub mod sensors;
 pub mod sim;
 pub mod track;

@@ -147,6 +147,10 @@ pub struct Condition {
     pub train: Option<crate::sim::hitch::TrainSetup>,
     /// The consist as the plan names it (`daqin_20kt` or a file), for the manifest.
     pub consist: Option<String>,
+    /// The condition whose irregularities this one's runs share, seed for seed (None: its
+    /// own, from its name). A sensitivity study's copies of a condition share their base's,
+    /// so a parameter's effect is not buried under a new track (common random numbers).
+    pub realisation_of: Option<String>,
 }
 
 impl Condition {
@@ -311,6 +315,7 @@ impl Plan {
                 start_m: c.start_m,
                 train,
                 consist: consist.filter(|n| n != crate::sim::hitch::ALONE),
+                realisation_of: None,
             });
         }
         // Every file the plan names must be there now, not when its run comes up (checked last,

@@ -42,6 +42,8 @@ mod mutation;
 mod mutation_commands;
 #[path = "neural.rs"]
 mod neural;
+#[path = "sensitivity.rs"]
+mod sensitivity;
 #[path = "sensors.rs"]
 mod sensors;
 #[path = "sklearn.rs"]

@@ -95,7 +95,35 @@ pub fn run(args: GenerateArgs) -> Result<()> {
         settle: args.settle,
         stepping: railforce::sim::Stepping::chosen(args.integrator.as_deref(), args.dt),
     };
-    let total = dataset::runs(&plan)
+    let t0 = std::time::Instant::now();
+    let (manifest, generated, skipped) = with_progress(&plan, &opts)?;
+    let runs = manifest.runs.len();
+    if generated == 0 && skipped > 0 {
+        println!(
+            "nothing to do: all {skipped} runs are already in {} with the same settings (delete a run file to redo it)",
+            args.out.display()
+        );
+    } else {
+        println!(
+            "{runs} runs in {} ({} format): {generated} generated, {skipped} skipped (already done), {:.1} s with {jobs} jobs; manifest: {}",
+            args.out.display(),
+            format.ext(),
+            t0.elapsed().as_secs_f64(),
+            dataset::manifest_path(&opts).display()
+        );
+    }
+    Ok(())
+}
+
+/// Generates `plan` with a progress bar on a terminal, or one plain line per run in a log
+/// (Slurm, nohup, CI) with the count, elapsed time and an estimate of what is left. Returns
+/// the manifest and how many runs were generated and skipped.
+pub(super) fn with_progress(
+    plan: &Plan,
+    opts: &GenerateOptions,
+) -> Result<(dataset::Manifest, usize, usize)> {
+    let shard = opts.shard;
+    let total = dataset::runs(plan)
         .iter()
         .filter(|r| shard.is_none_or(|(i, n)| r.index % n == i - 1))
         .count();
@@ -152,24 +180,9 @@ pub fn run(args: GenerateArgs) -> Result<()> {
     if !tty {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
-    let result = dataset::generate(&plan, &opts, &on_event);
+    let result = dataset::generate(plan, opts, &on_event);
     bar.finish_and_clear();
     let manifest = result?;
     let (_, generated, skipped) = *state.lock().expect("lock");
-    let runs = manifest.runs.len();
-    if generated == 0 && skipped > 0 {
-        println!(
-            "nothing to do: all {skipped} runs are already in {} with the same settings (delete a run file to redo it)",
-            args.out.display()
-        );
-    } else {
-        println!(
-            "{runs} runs in {} ({} format): {generated} generated, {skipped} skipped (already done), {:.1} s with {jobs} jobs; manifest: {}",
-            args.out.display(),
-            format.ext(),
-            t0.elapsed().as_secs_f64(),
-            dataset::manifest_path(&opts).display()
-        );
-    }
-    Ok(())
+    Ok((manifest, generated, skipped))
 }

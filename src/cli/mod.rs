@@ -14,6 +14,7 @@ mod generate;
 mod identify;
 mod modes;
 mod select;
+mod sensitivity;
 mod simulate;
 mod track;
 mod train;
@@ -106,6 +107,20 @@ enum Command {
         after_help = "Examples:\n  railforce generate --plan demo --out data/demo --snr-db 6\n  (the paper's 34 conditions, 136 runs: railforce generate --plan paper34 --out data/paper34 --snr-db 6)"
     )]
     Generate(generate::GenerateArgs),
+    /// What the labels depend on: Morris screening (every estimate of an estimates file over
+    /// its stated range, ranked by μ*) and Sobol first and total indices (the top few), on the
+    /// labels' mean, std, 99.85 % percentile and band std per condition.
+    ///
+    /// The study is a plan: each condition of the base plan is copied per design point (each
+    /// copy sharing its base's irregularities), generated like `generate` (jobs, `--shard`,
+    /// resume after an interruption), then read back into ranked tables and tornado charts
+    /// (`OUT/index.html`). Every range is tried on the files' loaders before any run: a range
+    /// outside an element's bounds, or an estimate without a range or a source, is refused
+    /// naming the file and key.
+    #[command(
+        after_help = "Examples:\n  railforce sensitivity --out sensitivity                  (Morris, 10 trajectories)\n  railforce sensitivity --out sensitivity --method sobol   (the screening's top 5)\n  railforce sensitivity --shard 1/4 …, then --merge        (on a cluster)"
+    )]
+    Sensitivity(sensitivity::SensitivityArgs),
     /// Feature selection on a data set: mutual information of each of the 21 inputs with the
     /// target (Kraskov k = 3), then forward selection by validation R² of ridge regression on
     /// flattened windows; writes the selected channels and their z-score statistics.
@@ -258,6 +273,7 @@ pub fn main() -> ExitCode {
         Command::Modes(args) => modes::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Generate(args) => generate::run(args),
+        Command::Sensitivity(args) => sensitivity::run(args),
         Command::Select(args) => select::run(args),
         Command::Train(args) => train::run(args),
         Command::Evaluate(args) => evaluate::run(args),

@@ -114,9 +114,11 @@ pub fn realisation_seed(condition: &str, seed: u64) -> u64 {
 }
 
 impl RunSpec {
-    /// The seed of the run's irregularities and noise: [`realisation_seed`].
+    /// The seed of the run's irregularities and noise: [`realisation_seed`] of its condition
+    /// (or of the condition it shares its realisation with, `Condition::realisation_of`).
     pub fn realisation_seed(&self) -> u64 {
-        realisation_seed(&self.condition.name, self.seed)
+        let c = &self.condition;
+        realisation_seed(c.realisation_of.as_deref().unwrap_or(&c.name), self.seed)
     }
 
     /// Output file name.

@@ -5,6 +5,7 @@
 
 pub mod svg;
 pub mod table;
+pub mod tornado;
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};

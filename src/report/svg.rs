@@ -102,6 +102,8 @@ pub enum Figure {
     Line(Chart),
     /// Grouped bars.
     Bars(BarChart),
+    /// Horizontal ranked bars.
+    Tornado(super::tornado::Tornado),
 }
 
 impl Figure {
@@ -110,6 +112,7 @@ impl Figure {
         match self {
             Figure::Line(c) => c.to_svg(),
             Figure::Bars(b) => b.to_svg(),
+            Figure::Tornado(t) => t.to_svg(),
         }
     }
 }
