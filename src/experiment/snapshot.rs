@@ -18,6 +18,9 @@ pub const HEADLINE_BEGIN: &str =
 /// The line after it.
 pub const HEADLINE_END: &str = "<!-- results:headline:end -->";
 
+/// The folders of a sensitivity study in an experiment's output folder, shown after its parts.
+const SENSITIVITY: [&str; 2] = ["sensitivity/morris", "sensitivity/sobol"];
+
 /// Writes the snapshot of the run in `out` to `dest` (atomically), copying the parts'
 /// figures into `dest`'s folder under `results/<part>/` unless `dest` lies in `out`. A run
 /// that has not finished (no `meta.json` of the whole run) is written from the parts that
@@ -102,7 +105,10 @@ pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
         minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0)),
     ]);
     md += &wt.markdown();
-    for f in Which::FOLDERS {
+    // The experiments' parts, then a sensitivity study run into the same folder
+    // (`railforce sensitivity --out OUT/sensitivity`): the labels' own uncertainty beside the
+    // networks' R² (its long table of every measure stays in its CSV).
+    for f in Which::FOLDERS.into_iter().chain(SENSITIVITY) {
         let Some(sec) = SavedSection::read(&out.join(f))? else {
             continue;
         };
@@ -110,7 +116,7 @@ pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
         for p in &sec.text {
             md += &format!("{p}\n\n");
         }
-        for (cap, t, _) in &sec.tables {
+        for (cap, t, _) in sec.tables.iter().filter(|t| t.2 != "measures") {
             md += &format!("**{cap}**\n\n{}\n", t.markdown());
         }
         for (cap, name) in &sec.figures {
