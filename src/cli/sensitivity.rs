@@ -76,18 +76,7 @@ pub fn run(args: SensitivityArgs) -> Result<()> {
             };
             let parameters = keys
                 .iter()
-                .map(|k| {
-                    estimates
-                        .estimates
-                        .iter()
-                        .position(|e| e.variation.key == *k)
-                        .ok_or_else(|| {
-                            anyhow::anyhow!(
-                                "--parameters: {k} is not an estimate of {}",
-                                estimates.path.display()
-                            )
-                        })
-                })
+                .map(|k| super::with_flags(estimates.index_of(k), "--parameters"))
                 .collect::<Result<Vec<_>>>()?;
             Method::Sobol {
                 rows: args.rows,

@@ -145,6 +145,19 @@ impl Estimates {
         })
     }
 
+    /// The index of the estimate of `key`, or an error naming this file.
+    pub fn index_of(&self, key: &str) -> Result<usize> {
+        self.estimates
+            .iter()
+            .position(|e| e.variation.key == key)
+            .ok_or_else(|| {
+                Error::Domain(format!(
+                    "{key} is not an estimate of {}",
+                    self.path.display()
+                ))
+            })
+    }
+
     /// The estimates as one `[vary]` set over their whole ranges.
     pub fn vary(&self) -> Vary {
         Vary {
