@@ -3,14 +3,17 @@
 //! figures and a `section.json` that describes them; the index is rebuilt from every
 //! `section.json` present, so parts run one by one into one folder, in any order, all show.
 
+mod escape;
 pub mod svg;
 pub mod table;
 pub mod tornado;
 
+pub use escape::esc;
+
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
-use svg::{Figure, esc};
+use svg::Figure;
 use table::Table;
 
 /// A part of a report.

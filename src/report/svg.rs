@@ -3,6 +3,7 @@
 //! Both are sized for the report page (1 040 px wide by default) and carry their values as
 //! hover titles on bars and points.
 
+use super::escape::esc;
 use std::fmt::Write as _;
 
 /// One line (or set of points) of a line chart.
@@ -425,14 +426,6 @@ fn fmt(v: f64) -> String {
         let s = format!("{v:.3}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
-}
-
-/// Escapes text for XML/HTML.
-pub fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 #[cfg(test)]

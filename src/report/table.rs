@@ -1,6 +1,6 @@
 //! A table written three ways: Markdown, CSV and HTML.
 
-use super::svg::esc;
+use super::escape::esc;
 
 /// How a table shows a missing value.
 pub const MISSING: &str = "—";

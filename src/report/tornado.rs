@@ -2,7 +2,7 @@
 //! measures side by side (a sensitivity study's μ* of FL and FQ), with the values written at
 //! the bar ends.
 
-use super::svg::esc;
+use super::escape::esc;
 use std::fmt::Write;
 
 /// Horizontal bars, ranked as given (the caller sorts).
