@@ -28,6 +28,8 @@ speed_kmh = 60.0
 name = "grade20_L50_v60"
 track = "{t}/grade20_L50.toml"
 speed_kmh = 60.0
+consist = "daqin_20kt"
+position = 0.02
 "#,
         v = root.join("vehicles/c80.toml").display(),
         t = root.join("tracks").display()
