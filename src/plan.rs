@@ -154,6 +154,20 @@ pub struct Condition {
 }
 
 impl Condition {
+    /// The condition as [`crate::vary::check`] sees it (`index`: its place in the plan).
+    pub fn subject(&self, index: usize) -> crate::vary::Subject<'_> {
+        crate::vary::Subject {
+            index,
+            name: &self.name,
+            vehicle: &self.vehicle,
+            track: &self.track,
+            speed_kmh: self.speed_kmh,
+            class: self.class,
+            consist: self.train.as_ref().map(|t| &t.consist),
+            position: self.train.as_ref().and_then(|t| t.position),
+        }
+    }
+
     /// Running speed, m/s.
     pub fn speed(&self) -> f64 {
         self.speed_kmh / 3.6
@@ -362,21 +376,7 @@ impl Plan {
     pub fn check_vary(&self) -> Result<()> {
         let mut tried = Vec::new();
         for (index, c) in self.conditions.iter().enumerate() {
-            crate::vary::check(
-                &self.source,
-                crate::vary::Subject {
-                    index,
-                    name: &c.name,
-                    vehicle: &c.vehicle,
-                    track: &c.track,
-                    speed_kmh: c.speed_kmh,
-                    class: c.class,
-                    consist: c.train.as_ref().map(|t| &t.consist),
-                    position: c.train.as_ref().and_then(|t| t.position),
-                },
-                &c.vary,
-                &mut tried,
-            )?;
+            crate::vary::check(&self.source, c.subject(index), &c.vary, &mut tried)?;
         }
         Ok(())
     }

@@ -172,21 +172,7 @@ impl Estimates {
         let vary = self.vary();
         let mut tried = Vec::new();
         for (index, c) in plan.conditions.iter().enumerate() {
-            crate::vary::check(
-                &self.path,
-                crate::vary::Subject {
-                    index,
-                    name: &c.name,
-                    vehicle: &c.vehicle,
-                    track: &c.track,
-                    speed_kmh: c.speed_kmh,
-                    class: c.class,
-                    consist: c.train.as_ref().map(|t| &t.consist),
-                    position: c.train.as_ref().and_then(|t| t.position),
-                },
-                &vary,
-                &mut tried,
-            )?;
+            crate::vary::check(&self.path, c.subject(index), &vary, &mut tried)?;
         }
         Ok(())
     }

@@ -198,31 +198,15 @@ fn morris_table(
         row.push(e.source.clone());
         t.push(row);
     }
-    let top: Vec<usize> = ranked.iter().take(TOP).map(|x| x.0).collect();
-    let series = [
-        (0usize, "FL mean"),
-        (1, "FL std"),
-        (6, "FQ mean"),
-        (7, "FQ std"),
-    ]
-    .iter()
-    .map(|&(o, name)| {
-        (
-            format!("μ* {name}"),
-            top.iter().map(|&p| m[o][p].mu_star).collect(),
-        )
-    })
-    .collect();
-    (
-        t,
-        (
-            top.iter()
-                .map(|&p| sampled[p].variation.key.clone())
-                .collect(),
-            series,
-            "μ*, kN for a move across the range".into(),
-        ),
-    )
+    let bars = tornado_bars(
+        ranked,
+        sampled,
+        &[(0, "FL mean"), (1, "FL std"), (6, "FQ mean"), (7, "FQ std")],
+        "μ*",
+        |o, p| m[o][p].mu_star,
+        "μ*, kN for a move across the range",
+    );
+    (t, bars)
 }
 
 fn sobol_table(
@@ -256,25 +240,43 @@ fn sobol_table(
             ci(m[8][p].total, m[8][p].total_ci),
         ]);
     }
+    let bars = tornado_bars(
+        ranked,
+        sampled,
+        &[(1, "FL std"), (7, "FQ std")],
+        "ST",
+        |o, p| m[o][p].total,
+        "total Sobol index",
+    );
+    (t, bars)
+}
+
+/// The tornado's rows (the `TOP` best ranked keys) and one series per `(output, name)`,
+/// labelled `<measure> <name>`, its bars `value(output, parameter)`.
+fn tornado_bars(
+    ranked: &[(usize, f64)],
+    sampled: &[&super::Estimate],
+    outputs: &[(usize, &str)],
+    measure: &str,
+    value: impl Fn(usize, usize) -> f64,
+    x_label: &str,
+) -> Bars {
     let top: Vec<usize> = ranked.iter().take(TOP).map(|x| x.0).collect();
-    let series = [(1usize, "FL std"), (7, "FQ std")]
+    let series = outputs
         .iter()
         .map(|&(o, name)| {
             (
-                format!("ST {name}"),
-                top.iter().map(|&p| m[o][p].total).collect(),
+                format!("{measure} {name}"),
+                top.iter().map(|&p| value(o, p)).collect(),
             )
         })
         .collect();
     (
-        t,
-        (
-            top.iter()
-                .map(|&p| sampled[p].variation.key.clone())
-                .collect(),
-            series,
-            "total Sobol index".into(),
-        ),
+        top.iter()
+            .map(|&p| sampled[p].variation.key.clone())
+            .collect(),
+        series,
+        x_label.into(),
     )
 }
 
