@@ -77,7 +77,7 @@ fn shear_pad_resists_side_frame_roll_by_its_width_until_it_tips() {
     states[pad.upper.body].rotation = UnitQuaternion::from_euler_angles(theta, 0.0, 0.0);
     let mut flat = pad.clone();
     flat.width = 0.0;
-    let mut m = [0.0; 4];
+    let mut m = [0.0; railforce::vehicle::elements::MEMORY];
     let with = wrenches(&Element::ShearPad(pad.clone()), &states, &mut m);
     let without = wrenches(&Element::ShearPad(flat), &states, &mut m);
     let x = states[pad.upper.body].rotation * Vector3::x();
@@ -107,7 +107,7 @@ fn centre_plate_sticks_then_slips_at_its_friction_moment() {
     assert!((limit - cp.friction * cp.preload * 2.0 / 3.0 * cp.radius).abs() < 1e-6 * limit);
     let e = Element::CentrePlate(cp.clone());
     let mut states = at_rest(c80());
-    let mut memory = [0.0; 4];
+    let mut memory = [0.0; railforce::vehicle::elements::MEMORY];
     let mut psi = 0.0;
     for i in 0..=400 {
         psi = i as f64 * 1e-4; // up to 40 mrad
@@ -141,7 +141,7 @@ fn side_bearer_sticks_then_slips_at_its_friction_force() {
     let limit = sb.friction * sb.preload;
     let mut states = at_rest(c80());
     let x0 = states[sb.lower.body].position.x;
-    let mut memory = [0.0; 4];
+    let mut memory = [0.0; railforce::vehicle::elements::MEMORY];
     for i in 0..=100 {
         let d = i as f64 * 1e-4; // up to 10 mm
         states[sb.lower.body].position.x = x0 + d;
@@ -233,7 +233,7 @@ fn moment_about_pad_line(
     states[sf].rotation = rot;
     states[bolster].position.y += bolster_dy;
     let mut wr = vec![Wrench::default(); states.len()];
-    let mut m = [0.0; 4];
+    let mut m = [0.0; railforce::vehicle::elements::MEMORY];
     for e in elements {
         e.apply(&states, &mut m, &mut wr, 2e-4);
     }
@@ -441,7 +441,7 @@ fn static_equilibrium_every_support_carries_the_weight_above_it() {
     for v in [c80(), c80_empty()] {
         let states = at_rest(v);
         let mut wr = vec![Wrench::default(); states.len()];
-        let mut m = [0.0; 4];
+        let mut m = [0.0; railforce::vehicle::elements::MEMORY];
         for e in &v.elements {
             e.apply(&states, &mut m, &mut wr, 2e-4);
         }
@@ -535,7 +535,7 @@ fn elements_are_left_right_mirror_symmetric() {
     let all = |st: &[BodyState]| {
         let mut wr = vec![Wrench::default(); st.len()];
         for e in &v.elements {
-            e.apply(st, &mut [0.0; 4], &mut wr, 2e-4);
+            e.apply(st, &mut [0.0; railforce::vehicle::elements::MEMORY], &mut wr, 2e-4);
         }
         wr
     };

@@ -341,7 +341,7 @@ impl<'a> Simulation<'a> {
             table,
             states,
             wrenches: vec![Wrench::default(); n],
-            memory: vec![[0.0; 4]; vehicle.elements.len()],
+            memory: vec![[0.0; crate::vehicle::elements::MEMORY]; vehicle.elements.len()],
             body_s,
             rails: vec![
                 RailState {

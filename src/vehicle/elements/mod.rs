@@ -14,6 +14,7 @@
 mod centre_plate;
 mod cross_bracing;
 mod lateral_stop;
+pub mod rubber;
 mod shear_pad;
 mod side_bearer;
 mod spring_nest;
@@ -25,13 +26,17 @@ pub use cross_bracing::CrossBracing;
 pub use lateral_stop::LateralStop;
 pub use shear_pad::ShearPad;
 pub use side_bearer::SideBearer;
-pub use spring_nest::{NestLaw, SpringNest};
+pub use spring_nest::{NestLaw, NestStaging, SpringNest};
 pub use track_spring::TrackSpring;
-pub use wedge_damper::{WedgeDamper, slider};
+pub use wedge_damper::{WedgeDamper, WedgeStatics, slider};
 
 /// Internal state of an element that has one (the friction sliders of wedges, centre plates and
 /// side bearers), zero at the static position; the simulation keeps one per element.
-pub type Memory = [f64; 4];
+pub type Memory = [f64; MEMORY];
+
+/// Length of an element's [`Memory`]: the shear pad's rubber holds three Maxwell branches on
+/// each of its three axes and its rocking.
+pub const MEMORY: usize = 12;
 
 use super::binder::Binder;
 use super::body::{Attachment, BodyState, Wrench};

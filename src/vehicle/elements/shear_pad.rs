@@ -14,7 +14,13 @@
 //! hold its pitch to the side frame's. So the crown is found in the adapter's axes (the axle's
 //! direction, and the side frame's vertical square to it), and the pad's moment about the
 //! axle's axis goes to the side frame through the jaws, never spinning the wheelset.
+//!
+//! The rubber's damping is either viscous (`damping`, N·s/m per axis: its loss factor
+//! `c·ω/k` grows with frequency) or a loss factor held over 1–50 Hz (`loss_factor` per axis:
+//! [`super::rubber`]'s Maxwell chain, the file's `stiffness` its static stiffness, the
+//! rocking taking the vertical axis' rubber).
 
+use super::rubber::{BRANCHES, Rubber};
 use super::{Element, ElementDamping, ForceElement, Memory, Relative, Support};
 use crate::error::Result;
 use crate::vehicle::binder::Binder;
@@ -40,6 +46,8 @@ pub struct ShearPad {
     pub preload: f64,
     /// Lateral width of the pad under the pedestal roof, m (0: no roll resistance).
     pub width: f64,
+    /// Rubber with a constant loss factor (x, y, z), where the file gives one.
+    pub rubber: Option<[Rubber; 3]>,
 }
 
 impl ShearPad {
@@ -75,11 +83,17 @@ impl ShearPad {
         }
     }
 
-    fn forces(&self, states: &[BodyState], wrenches: &mut [Wrench]) {
+    fn forces(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
         let r = self.relative(states);
-        let f = self.stiffness.component_mul(&r.d)
+        let mut f = self.stiffness.component_mul(&r.d)
             + self.damping.component_mul(&r.v)
             + Vector3::new(0.0, 0.0, self.preload);
+        if let Some(rubber) = &self.rubber {
+            for (i, rb) in rubber.iter().enumerate() {
+                let u = &mut memory[i * BRANCHES..(i + 1) * BRANCHES];
+                f[i] += rb.branch_force(self.stiffness[i], r.d[i], u, dt);
+            }
+        }
         r.apply(f, &self.upper, &self.lower, states, wrenches);
         // The moment about the axle's axis of the force at the crown goes through the adapter's
         // jaws to the side frame: the bearing carries none.
@@ -99,7 +113,17 @@ impl ShearPad {
             let w_lower = sl.angular_velocity - axle * sl.angular_velocity.dot(&axle);
             let x_upper = r.axes.column(0).into_owned();
             let theta_dot = (su.angular_velocity - w_lower).dot(&x_upper);
-            let m = self.rocking_moment(theta, theta_dot, f.z);
+            let m = match &self.rubber {
+                None => self.rocking_moment(theta, theta_dot, f.z),
+                Some(rubber) => {
+                    // The vertical axis' rubber over the bed: static `k_z·w²/12` and its
+                    // branches, no more than the load tipping on an edge.
+                    let u = &mut memory[3 * BRANCHES..4 * BRANCHES];
+                    let k = self.rocking_stiffness();
+                    let tip = 0.5 * self.width * f.z.max(0.0);
+                    (k * theta + rubber[2].branch_force(k, theta, u, dt)).clamp(-tip, tip)
+                }
+            };
             wrenches[self.upper.body].torque -= x_upper * m;
             wrenches[self.lower.body].torque += x_upper * m;
         }
@@ -135,6 +159,9 @@ pub(crate) struct ShearPadFile {
     stiffness: [f64; 3],
     #[serde(default)]
     damping: [f64; 3],
+    /// Loss factor per axis, held over 1–50 Hz (instead of `damping`).
+    #[serde(default)]
+    loss_factor: Option<[f64; 3]>,
     /// Lateral width of the pad, m (0 or absent: a point spring).
     #[serde(default)]
     width_m: f64,
@@ -145,6 +172,27 @@ impl ShearPad {
         b.non_negative(format!("{f}.stiffness"), &e.stiffness)?;
         b.non_negative(format!("{f}.damping"), &e.damping)?;
         b.non_negative(format!("{f}.width_m"), &[e.width_m])?;
+        let rubber = match e.loss_factor {
+            None => None,
+            Some(eta) => {
+                if e.damping.iter().any(|&c| c != 0.0) {
+                    return Err(b.err(
+                        format!("{f}.loss_factor"),
+                        "give damping (viscous) or loss_factor (constant over 1–50 Hz), not both",
+                    ));
+                }
+                let mut r = [None; 3];
+                for (i, &x) in eta.iter().enumerate() {
+                    r[i] = Some(Rubber::fit(x).ok_or_else(|| {
+                        b.err(
+                            format!("{f}.loss_factor"),
+                            format!("{x}: a rubber's loss factor lies in (0, 1)"),
+                        )
+                    })?);
+                }
+                Some(r.map(|x| x.expect("fitted above")))
+            }
+        };
         let (upper, lower, rest) =
             b.pair(f, (&e.upper, &e.lower), e.at, (e.upper_at, e.lower_at))?;
         Ok(ShearPad {
@@ -155,6 +203,7 @@ impl ShearPad {
             damping: Vector3::from(e.damping),
             preload: 0.0,
             width: e.width_m,
+            rubber,
         })
     }
 }
@@ -166,8 +215,8 @@ impl ForceElement for ShearPad {
         Self::from_row(f, e, b)
     }
     #[inline]
-    fn apply(&self, states: &[BodyState], _: &mut Memory, wrenches: &mut [Wrench], _: f64) {
-        self.forces(states, wrenches)
+    fn apply(&self, states: &[BodyState], memory: &mut Memory, wrenches: &mut [Wrench], dt: f64) {
+        self.forces(states, memory, wrenches, dt)
     }
     fn attachments(&self) -> Option<(&Attachment, &Attachment, &Vector3<f64>)> {
         Some((&self.upper, &self.lower, &self.rest))
@@ -278,7 +327,7 @@ mod tests {
         assert_eq!((d.upper, d.lower), (upper, lower));
         let wrench = |states: &[BodyState], body: usize| {
             let mut w = vec![Wrench::default(); states.len()];
-            pad.apply(states, &mut [0.0; 4], &mut w, 1e-3);
+            pad.apply(states, &mut [0.0; super::super::MEMORY], &mut w, 1e-3);
             let (f, t) = (w[body].force, w[body].torque);
             Vector6::new(f.x, f.y, f.z, t.x, t.y, t.z)
         };

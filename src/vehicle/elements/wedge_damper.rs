@@ -46,6 +46,33 @@ pub struct WedgeDamper {
     pub warp_ratio: f64,
     /// The nest whose load presses the wedge.
     pub nest: super::SpringNest,
+    /// How the wedge's balance sets the column's normal force.
+    pub statics: WedgeStatics,
+    /// Friction coefficient of the sloped face (two-face statics only).
+    pub slope_friction: f64,
+}
+
+/// The wedge's statics: how the control springs' force becomes the column face's normal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum WedgeStatics {
+    /// `N = P / tan α`: the slope frictionless, both strokes alike.
+    #[default]
+    OneFace,
+    /// Friction on both faces: loading and unloading strokes differ.
+    TwoFace,
+}
+
+impl WedgeStatics {
+    /// The file's names.
+    pub const NAMES: [&'static str; 2] = ["one_face", "two_face"];
+
+    fn parse(s: &str) -> Option<Self> {
+        match s {
+            "one_face" => Some(WedgeStatics::OneFace),
+            "two_face" => Some(WedgeStatics::TwoFace),
+            _ => None,
+        }
+    }
 }
 
 /// One step of a slider: a stick spring `k` with a damper `c` in parallel, in series with a
@@ -85,20 +112,28 @@ pub fn slider<const N: usize>(
 }
 
 impl WedgeDamper {
-    /// Force with which the wedges press the column face, `N = P / tan α`, for the control
-    /// springs' force `p` (N).
+    /// Force with which the wedges press the column face for the control springs' force `p`
+    /// (N), the column slipping with vertical direction cosine `nz` (+1 loading: the force
+    /// on the bolster up, the bolster moving down; −1 unloading): `P / tan α` one-face,
+    /// `P / (tan(α + n_z·φs) − n_z·μc)` two-face (module docs).
     #[inline]
-    pub fn column_normal(&self, p: f64) -> f64 {
-        p / self.angle.tan()
+    pub fn column_normal(&self, p: f64, nz: f64) -> f64 {
+        match self.statics {
+            WedgeStatics::OneFace => p / self.angle.tan(),
+            WedgeStatics::TwoFace => {
+                let phi = self.slope_friction.atan();
+                p / ((self.angle + nz * phi).tan() - nz * self.friction)
+            }
+        }
     }
 
     /// Friction limit of the column face and the nest's vertical force, for the nest at
-    /// compression `c` (m): `(μ·N, F_nest)`, N.
+    /// compression `c` (m) and the slip's vertical direction cosine `nz`: `(μ·N, F_nest)`, N.
     #[inline]
-    pub fn limits(&self, c: f64) -> (f64, f64) {
+    pub fn limits(&self, c: f64, nz: f64) -> (f64, f64) {
         let law = &self.nest.law;
         (
-            self.friction * self.column_normal(law.control_force(c)),
+            self.friction * self.column_normal(law.control_force(c), nz),
             law.force(c),
         )
     }
@@ -108,11 +143,22 @@ impl WedgeDamper {
         // The nest's own compression (its points are not the wedge's) sets the control springs.
         let n = &self.nest;
         let c = n.static_compression + Relative::new(&n.upper, &n.lower, &n.rest, states).d.z;
-        let (limit, nest_force) = self.limits(c);
         let mut s = Vector2::new(memory[0], memory[1]);
+        let (d, v) = (Vector2::new(r.d.y, r.d.z), Vector2::new(r.v.y, r.v.z));
+        // The stroke's direction from the trial force (the slider held): only the two-face
+        // statics tell the strokes apart.
+        let nz = match self.statics {
+            WedgeStatics::OneFace => 0.0,
+            WedgeStatics::TwoFace => {
+                let trial = (d - s) * self.stick_stiffness + v * self.stick_damping;
+                let n = trial.norm();
+                if n > 0.0 { trial.y / n } else { 0.0 }
+            }
+        };
+        let (limit, nest_force) = self.limits(c, nz);
         let face = slider(
-            &Vector2::new(r.d.y, r.d.z),
-            &Vector2::new(r.v.y, r.v.z),
+            &d,
+            &v,
             &mut s,
             self.stick_stiffness,
             self.stick_damping,
@@ -172,6 +218,12 @@ pub(crate) struct WedgeDamperFile {
     warp_stiffness: f64,
     #[serde(default)]
     warp_ratio_m: f64,
+    /// `one_face` (the default) or `two_face`.
+    #[serde(default)]
+    statics: Option<String>,
+    /// Sloped face's friction coefficient (two-face statics).
+    #[serde(default)]
+    slope_friction: Option<f64>,
 }
 
 impl WedgeDamper {
@@ -201,6 +253,49 @@ impl WedgeDamper {
         )?;
         b.non_negative(format!("{f}.warp_stiffness"), &[e.warp_stiffness])?;
         b.non_negative(format!("{f}.warp_ratio_m"), &[e.warp_ratio_m])?;
+        let statics = match &e.statics {
+            None => WedgeStatics::OneFace,
+            Some(s) => WedgeStatics::parse(s).ok_or_else(|| {
+                b.err(
+                    format!("{f}.statics"),
+                    format!("{s:?}: give one of {:?}", WedgeStatics::NAMES),
+                )
+            })?,
+        };
+        let slope_friction = match (statics, e.slope_friction) {
+            (WedgeStatics::OneFace, Some(_)) => {
+                return Err(b.err(
+                    format!("{f}.slope_friction"),
+                    "the one-face statics has a frictionless slope: set statics = \"two_face\" to use it",
+                ));
+            }
+            (WedgeStatics::OneFace, None) => 0.0,
+            (WedgeStatics::TwoFace, mu_s) => {
+                let mu_s = mu_s.ok_or_else(|| {
+                    b.err(
+                        format!("{f}.slope_friction"),
+                        "the two-face statics needs the sloped face's friction coefficient",
+                    )
+                })?;
+                b.non_negative(format!("{f}.slope_friction"), &[mu_s])?;
+                // Loading must not lock: tan(α + φs) > μc, and the angle plus φs below 90°.
+                let alpha = e.wedge_angle_deg.to_radians();
+                let phi = mu_s.atan();
+                if alpha + phi >= std::f64::consts::FRAC_PI_2
+                    || (alpha + phi).tan() <= e.friction
+                    || (alpha - phi).tan() + e.friction <= 0.0
+                {
+                    return Err(b.err(
+                        format!("{f}.slope_friction"),
+                        format!(
+                            "with wedge_angle_deg {} and friction {} a slope friction of {mu_s} locks the wedge (tan(α + atan μs) must exceed μc, α + atan μs stay below 90°)",
+                            e.wedge_angle_deg, e.friction
+                        ),
+                    ));
+                }
+                mu_s
+            }
+        };
         let (upper, lower, rest) =
             b.pair(f, (&e.upper, &e.lower), e.at, (e.upper_at, e.lower_at))?;
         Ok(WedgeDamper {
@@ -215,6 +310,8 @@ impl WedgeDamper {
             warp_stiffness: e.warp_stiffness,
             warp_ratio: e.warp_ratio_m,
             nest,
+            statics,
+            slope_friction,
         })
     }
 }
@@ -261,4 +358,117 @@ fn nest_between(elements: &[Element], upper: usize, lower: usize) -> Option<&sup
         Element::SpringNest(n) if n.upper.body == upper && n.lower.body == lower => Some(n),
         _ => None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vehicle::elements::NestLaw;
+    use nalgebra::UnitQuaternion;
+
+    fn wedge(statics: WedgeStatics, mu_c: f64, mu_s: f64, angle_deg: f64) -> WedgeDamper {
+        let at = |body| Attachment {
+            body,
+            local: Vector3::zeros(),
+        };
+        let law = NestLaw {
+            outer: 1e6,
+            inner: 0.0,
+            inner_gap: 1.0,
+            control: 5e5,
+            control_extra: 0.01,
+        };
+        WedgeDamper {
+            upper: at(0),
+            lower: at(1),
+            rest: Vector3::zeros(),
+            friction: mu_c,
+            angle: angle_deg.to_radians(),
+            stick_stiffness: 2e7,
+            stick_damping: 0.0,
+            longitudinal_stiffness: 0.0,
+            warp_stiffness: 0.0,
+            warp_ratio: 0.0,
+            nest: super::super::SpringNest {
+                upper: at(0),
+                lower: at(1),
+                rest: Vector3::zeros(),
+                law,
+                lateral_stiffness: [0.0; 2],
+                static_compression: 0.03,
+                footprint: [0.0; 2],
+                staging: Default::default(),
+            },
+            statics,
+            slope_friction: mu_s,
+        }
+    }
+
+    /// Drives the side frame (lower) vertically relative to the bolster through a ramp of
+    /// `stroke` (m) in 400 steps and returns the column force on the bolster at the end,
+    /// over the control springs' force.
+    fn sliding_force_ratio(w: &WedgeDamper, stroke: f64) -> f64 {
+        let still = BodyState {
+            position: Vector3::zeros(),
+            rotation: UnitQuaternion::identity(),
+            velocity: Vector3::zeros(),
+            angular_velocity: Vector3::zeros(),
+        };
+        let mut memory = [0.0; crate::vehicle::elements::MEMORY];
+        let mut f = 0.0;
+        let n = 400;
+        let dt = 1e-3;
+        for i in 1..=n {
+            let z = stroke * i as f64 / n as f64;
+            let mut lower = still;
+            lower.position.z = z;
+            lower.velocity.z = stroke / (n as f64 * dt);
+            let mut wrenches = [Wrench::default(); 2];
+            w.forces(&[still, lower], &mut memory, &mut wrenches, dt);
+            f = wrenches[0].force.z;
+        }
+        // The nest's compression follows the relative motion (its own points are the wedge's).
+        let c = w.nest.static_compression + stroke;
+        f / w.nest.law.control_force(c)
+    }
+
+    #[test]
+    fn two_face_statics_match_the_closed_forms() {
+        // Closed forms (module docs; the specification's table at θ = 37.5°):
+        // loading μc/(tan(θ+φs) − μc), unloading μc/(tan(θ−φs) + μc).
+        for (mu_s, load, unload) in [(0.0, 0.642, 0.281), (0.3, 0.276, 0.441)] {
+            let w = wedge(WedgeStatics::TwoFace, 0.3, mu_s, 37.5);
+            let phi: f64 = f64::atan(mu_s);
+            let th = 37.5f64.to_radians();
+            let exact_load = 0.3 / ((th + phi).tan() - 0.3);
+            let exact_unload = 0.3 / ((th - phi).tan() + 0.3);
+            assert!((exact_load - load).abs() < 5e-4 && (exact_unload - unload).abs() < 5e-4);
+            // Loading: the side frame rises against the bolster (the bolster moves down on it),
+            // the friction on the bolster acts up.
+            let up = sliding_force_ratio(&w, 0.005);
+            assert!((up - exact_load).abs() < 1e-9, "loading {up} vs {exact_load}");
+            let down = sliding_force_ratio(&w, -0.005);
+            assert!(
+                (down + exact_unload).abs() < 1e-9,
+                "unloading {down} vs −{exact_unload}"
+            );
+        }
+        // One face: both strokes μ/tan α.
+        let w = wedge(WedgeStatics::OneFace, 0.3, 0.0, 37.5);
+        let exact = 0.3 / 37.5f64.to_radians().tan();
+        assert!((sliding_force_ratio(&w, 0.005) - exact).abs() < 1e-9);
+        assert!((sliding_force_ratio(&w, -0.005) + exact).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_lateral_slip_takes_the_slopes_mean() {
+        let w = wedge(WedgeStatics::TwoFace, 0.3, 0.3, 37.5);
+        let p = 1000.0;
+        assert!((w.column_normal(p, 0.0) - p / 37.5f64.to_radians().tan()).abs() < 1e-9);
+        // Between the strokes, monotone in n_z.
+        let ns: Vec<f64> = (-10..=10)
+            .map(|i| w.column_normal(p, i as f64 / 10.0))
+            .collect();
+        assert!(ns.windows(2).all(|x| x[1] < x[0]), "{ns:?}");
+    }
 }
