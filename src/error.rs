@@ -35,6 +35,11 @@ pub enum Error {
     /// A query or computation went outside what the model supports.
     #[error("{0}")]
     Domain(String),
+    /// A wheel left its rail in a run (flange climb, lift or lateral shift past the limits,
+    /// or Nadal's limit held where the run was told to stop on it): the message names the
+    /// time, the place and the wheel.
+    #[error("{0}")]
+    Derailment(String),
 }
 
 impl Error {

@@ -23,6 +23,10 @@ struct PlanFile {
     consist: Option<String>,
     /// The wagon's place in that train, a fraction of its length from the head.
     position: Option<f64>,
+    /// Which way the curves turn: `as_drawn`, `mirrored` or `both`.
+    turn: Option<String>,
+    /// What a run that derails does to the data set: `fail` (the default) or `drop`.
+    derailed: Option<String>,
     #[serde(default)]
     condition: Vec<ConditionFile>,
 }
@@ -55,7 +59,43 @@ struct ConditionFile {
     start_m: Option<f64>,
     consist: Option<String>,
     position: Option<f64>,
+    turn: Option<String>,
+    gauge_face: Option<String>,
     vary: Option<toml::Table>,
+}
+
+/// Friction of a lubricated gauge face: wayside lubrication brings the flange's friction "to
+/// less than 0.2" with the top of rail at 0.3–0.4 (Prahl, *Mass Transit* 31(3), 2005,
+/// 54–58); 0.15 is an estimate within that.
+pub const LUBRICATED_GAUGE_FACE: f64 = 0.15;
+
+/// Which way a condition's curves turn, run by run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Turns {
+    /// As the track file draws them.
+    #[default]
+    AsDrawn,
+    /// Every curve the other way (a left-hand track for a right-hand file).
+    Mirrored,
+    /// Half the runs each way: the condition's k-th seed runs mirrored when k plus the
+    /// condition's place in the plan is odd, so the label wheel is the outer wheel in half the
+    /// runs and the held-out seeds of neighbouring conditions turn opposite ways.
+    Both,
+}
+
+impl Turns {
+    /// The file's names.
+    pub const NAMES: [&'static str; 3] = ["as_drawn", "mirrored", "both"];
+
+    /// Parses a file's name.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "as_drawn" => Some(Turns::AsDrawn),
+            "mirrored" => Some(Turns::Mirrored),
+            "both" => Some(Turns::Both),
+            _ => None,
+        }
+    }
 }
 
 /// Largest number of seeds one list or range may give (a typo such as `"1-100000000"` should
@@ -151,6 +191,13 @@ pub struct Condition {
     /// own, from its name). A sensitivity study's copies of a condition share their base's,
     /// so a parameter's effect is not buried under a new track (common random numbers).
     pub realisation_of: Option<String>,
+    /// Which way the curves turn, run by run.
+    pub turns: Turns,
+    /// The condition's place in its plan (0 first), for [`Turns::Both`].
+    pub order: usize,
+    /// Friction of the rail's gauge face instead of the vehicle file's (`gauge_face =
+    /// "lubricated"`: [`LUBRICATED_GAUGE_FACE`]; `"dry"` or absent: the file's).
+    pub flange_friction: Option<f64>,
 }
 
 impl Condition {
@@ -172,6 +219,18 @@ impl Condition {
     pub fn speed(&self) -> f64 {
         self.speed_kmh / 3.6
     }
+
+    /// Whether the run of seed `seed` turns its curves the other way from its track file.
+    pub fn mirrored(&self, seed: u64) -> bool {
+        match self.turns {
+            Turns::AsDrawn => false,
+            Turns::Mirrored => true,
+            Turns::Both => {
+                let k = self.seeds.iter().position(|&s| s == seed).unwrap_or(0);
+                (k + self.order) % 2 == 1
+            }
+        }
+    }
 }
 
 /// A validated plan.
@@ -187,6 +246,10 @@ pub struct Plan {
     pub conditions: Vec<Condition>,
     /// Data-set options.
     pub dataset: DatasetOptions,
+    /// Whether a run that derails is dropped from the data set (listed in its manifest with
+    /// the reason) instead of stopping the generation (`derailed = "drop"`; a fleet that
+    /// draws light wagons on poor track at speed may derail, as such wagons do).
+    pub drop_derailed: bool,
 }
 
 impl Plan {
@@ -308,6 +371,33 @@ impl Plan {
                     "a position in no train: name its `consist` too",
                 ));
             }
+            let turns = match c.turn.as_deref().or(raw.turn.as_deref()) {
+                None => Turns::AsDrawn,
+                Some(t) => Turns::parse(t).ok_or_else(|| {
+                    Error::config(
+                        path,
+                        if c.turn.is_some() {
+                            f("turn")
+                        } else {
+                            "turn".into()
+                        },
+                        format!("{t:?}: give one of {:?}", Turns::NAMES),
+                    )
+                })?,
+            };
+            let flange_friction = match c.gauge_face.as_deref() {
+                None | Some("dry") => None,
+                Some("lubricated") => Some(LUBRICATED_GAUGE_FACE),
+                Some(g) => {
+                    return Err(Error::config(
+                        path,
+                        f("gauge_face"),
+                        format!(
+                            "{g:?}: give \"dry\" (the vehicle file's flange friction) or \"lubricated\""
+                        ),
+                    ));
+                }
+            };
             let train = match &consist {
                 Some(name) => crate::sim::hitch::TrainSetup::resolve(
                     name,
@@ -330,6 +420,9 @@ impl Plan {
                 train,
                 consist: consist.filter(|n| n != crate::sim::hitch::ALONE),
                 realisation_of: None,
+                turns,
+                order: conditions.len(),
+                flange_friction,
             });
         }
         // Every file the plan names must be there now, not when its run comes up (checked last,
@@ -356,6 +449,19 @@ impl Plan {
                 return Err(missing(format!("condition[{i}].vehicle"), &c.vehicle));
             }
         }
+        let drop_derailed = match raw.derailed.as_deref() {
+            None | Some("fail") => false,
+            Some("drop") => true,
+            Some(d) => {
+                return Err(Error::config(
+                    path,
+                    "derailed",
+                    format!(
+                        "{d:?}: give \"fail\" (stop the generation) or \"drop\" (leave the run out, listed in the manifest)"
+                    ),
+                ));
+            }
+        };
         Ok(Plan {
             source: path.to_path_buf(),
             name: raw.name.unwrap_or_else(|| {
@@ -366,6 +472,7 @@ impl Plan {
             vehicle,
             conditions,
             dataset,
+            drop_derailed,
         })
     }
 }

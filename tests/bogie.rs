@@ -415,7 +415,7 @@ fn wedge_friction_comes_from_its_control_springs() {
         let w = wedge(v);
         let c = w.nest.static_compression;
         let p = w.nest.law.control * (c + w.nest.law.control_extra);
-        let (limit, nest) = w.limits(c);
+        let (limit, nest) = w.limits(c, 0.0);
         assert!((limit - w.friction * p / w.angle.tan()).abs() < 1e-6 * limit);
         assert!((nest - w.nest.law.force(c)).abs() < 1e-6 * nest);
         ratios.push(limit / nest);
@@ -535,7 +535,12 @@ fn elements_are_left_right_mirror_symmetric() {
     let all = |st: &[BodyState]| {
         let mut wr = vec![Wrench::default(); st.len()];
         for e in &v.elements {
-            e.apply(st, &mut [0.0; railforce::vehicle::elements::MEMORY], &mut wr, 2e-4);
+            e.apply(
+                st,
+                &mut [0.0; railforce::vehicle::elements::MEMORY],
+                &mut wr,
+                2e-4,
+            );
         }
         wr
     };

@@ -193,6 +193,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
                 model: ContactModel {
                     material: Material::STEEL,
                     friction: args.mu,
+                    flange_friction: args.mu,
                     law,
                     damping_ratio: 0.05,
                 },

@@ -155,6 +155,11 @@ pub(super) fn with_progress(
                 st.1 += 1;
                 Some(format!("done {f} in {wall:.1} s"))
             }
+            Event::Dropped(f, why) => {
+                st.0.retain(|x| *x != f);
+                st.1 += 1;
+                Some(format!("dropped {f}: {why}"))
+            }
         };
         let Some(line) = line else {
             bar.set_message(st.0.join(" "));

@@ -15,7 +15,7 @@ mod table_cache;
 pub mod validate;
 mod wheel_rail;
 
-pub use creep::{CreepContact, CreepForce, CreepLaw, Creepage};
+pub use creep::{CreepContact, CreepForce, CreepLaw, Creepage, PolachParams};
 pub use elastic::{PatchLoad, StripQuery, StripTable};
 pub use geometry::{ContactState, Side, WheelContact, WheelsetGeometry};
 pub use hertz::{HertzEllipse, HertzShape, Material};

@@ -258,11 +258,12 @@ pub fn tractcurv(reference: &Reference) -> Result<Vec<CreepRow>> {
             mu,
             shear_modulus: 82e9,
             poisson: 0.28,
+            speed: 0.0,
         };
         let law = if f[0] == "fastsim" {
             CreepLaw::Fastsim { n: 200 }
         } else {
-            CreepLaw::Polach
+            CreepLaw::default()
         };
         let fx = law
             .force(

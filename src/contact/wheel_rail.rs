@@ -16,6 +16,11 @@ use super::table::ContactTable;
 /// nor an explicit step follows as V → 0.
 pub const CREEP_SPEED_FLOOR: f64 = 5.0;
 
+/// Contact angle beyond which a patch lies on the rail's gauge face and takes the flange's
+/// friction, rad (35°: past the gauge corner's middle, where wayside lubricators' grease
+/// lies; an estimate).
+pub const GAUGE_FACE_ANGLE: f64 = 35.0 * std::f64::consts::PI / 180.0;
+
 /// Contact settings of a vehicle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactModel {
@@ -23,6 +28,9 @@ pub struct ContactModel {
     pub material: Material,
     /// Friction coefficient.
     pub friction: f64,
+    /// Friction coefficient of a patch on the gauge face (contact angle beyond
+    /// [`GAUGE_FACE_ANGLE`]): the flange's, lubricated or dry.
+    pub flange_friction: f64,
     /// Creep force law.
     pub law: CreepLaw,
     /// Damping ratio of the normal contact (of the linearised contact spring with the mass
@@ -263,9 +271,14 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
                 a: ellipse.a,
                 b: ellipse.b,
                 normal,
-                mu: model.friction,
+                mu: if l.angle.abs() > GAUGE_FACE_ANGLE {
+                    model.flange_friction
+                } else {
+                    model.friction
+                },
                 shear_modulus: model.material.shear_modulus(),
                 poisson: model.material.poisson,
+                speed,
             },
             &kalker,
             creepage,

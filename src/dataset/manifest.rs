@@ -163,6 +163,10 @@ pub struct RunEntry {
     /// consist file's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position: Option<f64>,
+    /// Whether the run's curves turned the other way from its track file's (the plan's
+    /// `turn`; absent: as drawn).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub mirrored: bool,
     /// Rows written. (Format 3 manifests also held each run's wall time, read and
     /// dropped: a manifest holds only what shapes the data, so one plan gives one manifest's
     /// bytes whether one process, shards or workers made it.)
@@ -219,6 +223,21 @@ pub struct Manifest {
     pub channels: Option<Vec<ChannelEntry>>,
     /// The runs, sorted by condition and seed.
     pub runs: Vec<RunEntry>,
+    /// Runs that derailed and were left out (the plan's `derailed = "drop"`), sorted by
+    /// condition and seed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dropped: Vec<DroppedRun>,
+}
+
+/// A run left out of a data set because its wagon derailed.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DroppedRun {
+    /// Condition name.
+    pub condition: String,
+    /// The run's seed.
+    pub seed: u64,
+    /// Where and how it derailed.
+    pub reason: String,
 }
 
 impl Manifest {
@@ -296,6 +315,8 @@ impl Manifest {
     pub(super) fn sort_runs(&mut self) {
         self.runs
             .sort_by(|a, b| (&a.condition, a.seed).cmp(&(&b.condition, b.seed)));
+        self.dropped
+            .sort_by(|a, b| (&a.condition, a.seed).cmp(&(&b.condition, b.seed)));
     }
 }
 
@@ -337,9 +358,16 @@ pub(super) fn run_key(
     vehicle_hash: &str,
     dataset: &DatasetOptions,
     draws: &crate::vary::Draws,
+    mirrored: bool,
 ) -> String {
     // Options added later enter the key only when set, so existing data sets keep their keys.
     let mut extra = String::new();
+    if mirrored {
+        extra += "|mirrored";
+    }
+    if let Some(mu) = run.condition.flange_friction {
+        extra += &format!("|gauge_face={mu}");
+    }
     if !draws.is_empty() {
         extra += &format!(
             "|vary={}",
@@ -529,6 +557,7 @@ pub fn merge(out: &Path) -> Result<Manifest> {
                     all.channels = m.channels;
                 }
                 all.runs.extend(m.runs);
+                all.dropped.extend(m.dropped);
             }
         }
     }

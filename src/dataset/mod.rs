@@ -13,8 +13,8 @@ mod table;
 
 pub use data_set::{DataSet, Run};
 pub use manifest::{
-    ChannelEntry, Conventions, FileRef, Integration, Labels, Manifest, RunEntry, data_identity,
-    file_hash, fnv1a, manifest_path, merge, parse_shard, run_entry,
+    ChannelEntry, Conventions, DroppedRun, FileRef, Integration, Labels, Manifest, RunEntry,
+    data_identity, file_hash, fnv1a, manifest_path, merge, parse_shard, run_entry,
 };
 use manifest::{refuse_mixing, run_key};
 pub use run_file::{CHANNEL_KINDS, keeps_f64, write_run};
@@ -131,6 +131,8 @@ impl RunSpec {
 /// its speed.
 struct Prepared {
     spec: TrackSpec,
+    /// Whether its curves turn the other way from the file's (and it has curves).
+    mirrored: bool,
     track_hash: String,
     draws: crate::vary::Draws,
     speed_kmh: f64,
@@ -160,6 +162,8 @@ pub enum Event {
     Skipped(String),
     /// A run finished, with its wall time.
     Finished(String, f64),
+    /// A run derailed and was left out (the plan's `derailed = "drop"`), with the reason.
+    Dropped(String, String),
 }
 
 /// Generates the data set of a plan (or of one shard of it). Returns the manifest.
@@ -270,8 +274,15 @@ pub fn generate(
                 ),
             ));
         }
+        // A run that turns the other way: every curve mirrored (a track without curves is its
+        // own mirror image, and stays as it is).
+        let mirrored = r.condition.mirrored(r.seed) && spec.has_curves();
+        if mirrored {
+            spec.mirror();
+        }
         tracks.push(Prepared {
             spec,
+            mirrored,
             track_hash: file_hash(&r.condition.track)?,
             draws,
             speed_kmh,
@@ -315,6 +326,7 @@ pub fn generate(
         },
         channels: None,
         runs: Vec::new(),
+        dropped: Vec::new(),
     });
     let next = AtomicUsize::new(0);
     let first_error: Mutex<Option<Error>> = Mutex::new(None);
@@ -322,6 +334,7 @@ pub fn generate(
         let run = &mine[k];
         let Prepared {
             spec,
+            mirrored,
             track_hash,
             draws,
             speed_kmh,
@@ -330,7 +343,15 @@ pub fn generate(
             .iter()
             .find(|v| v.0 == run.condition.vehicle)
             .expect("every condition's vehicle is loaded");
-        let key = run_key(run, opts, track_hash, vehicle_hash, dataset, draws);
+        let key = run_key(
+            run,
+            opts,
+            track_hash,
+            vehicle_hash,
+            dataset,
+            draws,
+            *mirrored,
+        );
         let file = run.file_name(opts.format);
         let path = opts.out.join(&file);
         if let Some(entry) = done.iter().find(|e| e.key == key)
@@ -355,7 +376,16 @@ pub fn generate(
         } else {
             None
         };
-        let vehicle = drawn_vehicle.as_ref().unwrap_or(shared);
+        // A lubricated gauge face: the wagon's flange friction as the condition has it.
+        let lubricated = run.condition.flange_friction.map(|mu| {
+            let mut v = drawn_vehicle.as_ref().unwrap_or(shared).clone();
+            v.contact.flange_friction = mu;
+            v
+        });
+        let vehicle = lubricated
+            .as_ref()
+            .or(drawn_vehicle.as_ref())
+            .unwrap_or(shared);
         let track = Track::new(spec.clone(), Some(run.realisation_seed()));
         // The wagon's place in its train, drawn or the condition's.
         let at =
@@ -391,9 +421,28 @@ pub fn generate(
         };
         let mut sim = Simulation::new(vehicle, &track, cfg)
             .map_err(|e| Error::Domain(format!("{}: {e}", run.condition.name)))?;
-        let mut rec = output::record(&mut sim, |_| {}).map_err(|e| {
-            Error::Domain(format!("{} (seed {}): {e}", run.condition.name, run.seed))
-        })?;
+        let mut rec = match output::record(&mut sim, |_| {}) {
+            Ok(rec) => rec,
+            Err(Error::Derailment(reason)) if plan.drop_derailed => {
+                events(Event::Dropped(file.clone(), reason.clone()));
+                manifest
+                    .lock()
+                    .expect("manifest lock")
+                    .dropped
+                    .push(manifest::DroppedRun {
+                        condition: run.condition.name.clone(),
+                        seed: run.seed,
+                        reason,
+                    });
+                return Ok(());
+            }
+            Err(e) => {
+                return Err(Error::Domain(format!(
+                    "{} (seed {}): {e}",
+                    run.condition.name, run.seed
+                )));
+            }
+        };
         if let Some(noise) = opts.noise {
             add_noise(&mut rec, &noise, run.realisation_seed());
         }
@@ -420,6 +469,7 @@ pub fn generate(
             start_m: run.condition.start_m,
             consist: run.condition.consist.clone(),
             position: train.as_ref().and_then(|t| t.position),
+            mirrored: *mirrored,
             rows: rec.rows.len(),
             peak_y_over_q: rec.summary.peak_y_over_q,
             draws: crate::vary::to_json(draws),

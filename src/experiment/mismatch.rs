@@ -66,6 +66,8 @@ fn with_fleet(plan: &Plan, fleet: &Plan) -> Result<Plan> {
     let mut p = plan.clone();
     p.name = fleet.name.clone();
     p.source = fleet.source.clone();
+    // A fleet may draw wagons that derail: its plan says whether they are left out.
+    p.drop_derailed = fleet.drop_derailed;
     for c in &mut p.conditions {
         let f = fleet
             .conditions
@@ -100,12 +102,14 @@ fn with_fleet(plan: &Plan, fleet: &Plan) -> Result<Plan> {
     Ok(p)
 }
 
-/// The experiment's plan at `seeds` with one extreme's fixed value on every condition.
-fn extreme(plan: &Plan, name: &str, table: &str, seeds: &[u64]) -> Result<Plan> {
+/// The experiment's plan at `seeds` with one extreme's fixed value on every condition (a
+/// run that derails left out as the fleet's are, where the fleet plan says so).
+fn extreme(plan: &Plan, name: &str, table: &str, seeds: &[u64], drop: bool) -> Result<Plan> {
     let t: toml::Table = toml::from_str(table).expect("a built-in [vary] table parses");
     let vary = Vary::parse(&t, &plan.source, &format!("mismatch.{name}"))?;
     let mut p = plan.clone();
     p.name = format!("{}_{name}", plan.name);
+    p.drop_derailed = drop;
     for c in &mut p.conditions {
         c.vary = vary.clone();
         c.seeds = seeds.to_vec();
@@ -233,7 +237,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     for (name, _, table) in EXTREMES {
         plans.push((
             name,
-            extreme(&plan, name, table, &test_seeds)?,
+            extreme(&plan, name, table, &test_seeds, fleet.drop_derailed)?,
             EvalPart::All,
         ));
     }

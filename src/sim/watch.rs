@@ -73,7 +73,7 @@ impl Simulation<'_> {
                     w.y_rel * 1e3
                 );
                 if self.cfg.stop_on_derailment {
-                    return Err(Error::Domain(msg));
+                    return Err(Error::Derailment(msg));
                 }
                 eprintln!("warning: {msg}");
             }
@@ -91,7 +91,7 @@ impl Simulation<'_> {
                     self.cfg.nadal_time * 1e3
                 );
                 if self.cfg.stop_on_derailment && self.cfg.stop_on_derailment_risk {
-                    return Err(Error::Domain(msg));
+                    return Err(Error::Derailment(msg));
                 }
                 eprintln!("warning: {msg}; the run goes on");
                 self.over_nadal[k] = f64::NEG_INFINITY;

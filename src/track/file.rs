@@ -135,6 +135,26 @@ pub struct TrackSpec {
 }
 
 impl TrackSpec {
+    /// Whether any section is a curve.
+    pub fn has_curves(&self) -> bool {
+        self.sections
+            .iter()
+            .any(|s| matches!(s.kind, SectionKind::Curve { .. }))
+    }
+
+    /// Turns every curve the other way (its cant goes to the other rail with it); the
+    /// irregularities and the vertical profile stay as they are.
+    pub fn mirror(&mut self) {
+        for s in &mut self.sections {
+            if let SectionKind::Curve { turn, .. } = &mut s.kind {
+                *turn = match turn {
+                    Turn::Left => Turn::Right,
+                    Turn::Right => Turn::Left,
+                };
+            }
+        }
+    }
+
     /// Reads and validates a track file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = crate::io::read_text(path)?;

@@ -59,8 +59,12 @@ struct ContactFile {
     #[serde(default = "default_gauge")]
     gauge_m: f64,
     friction: f64,
+    /// Friction on the gauge face (default: `friction`).
+    flange_friction: Option<f64>,
     #[serde(default = "default_law")]
     creep_law: String,
+    /// Polach 2005's parameters (with `creep_law = "polach"`).
+    polach: Option<PolachFile>,
     young_pa: f64,
     poisson: f64,
     #[serde(default = "default_damping_ratio")]
@@ -77,6 +81,20 @@ struct ContactFile {
     /// Mirror the rail profile file's y (MiniProf rails are measured with the field side to −y).
     #[serde(default)]
     rail_profile_mirror_y: bool,
+}
+
+/// `[contact.polach]`: Polach 2005's reduction factors and falling friction.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PolachFile {
+    /// Reduction factor of the adhesion term, kA.
+    ka: f64,
+    /// Reduction factor of the slip term, kS.
+    ks: f64,
+    /// Friction at infinite slip velocity over the static, A.
+    floor: f64,
+    /// Fall of friction with slip velocity, B, s/m.
+    decay_s_per_m: f64,
 }
 
 fn default_tape_offset() -> f64 {
@@ -179,7 +197,7 @@ pub(super) fn load_edited(
             format!("must lie in [0, 0.5), got {}", c.poisson),
         ));
     }
-    let law = CreepLaw::parse(&c.creep_law).ok_or_else(|| {
+    let mut law = CreepLaw::parse(&c.creep_law).ok_or_else(|| {
         cfg(
             "contact.creep_law".into(),
             format!(
@@ -188,6 +206,54 @@ pub(super) fn load_edited(
             ),
         )
     })?;
+    if let Some(p) = &c.polach {
+        let CreepLaw::Polach(_) = law else {
+            return Err(cfg(
+                "contact.polach".into(),
+                format!(
+                    "Polach's parameters need creep_law = \"polach\", not \"{}\"",
+                    c.creep_law
+                ),
+            ));
+        };
+        if !(p.ks > 0.0 && p.ks <= p.ka && p.ka <= 1.0) {
+            return Err(cfg(
+                "contact.polach.ka".into(),
+                format!(
+                    "Polach's reduction factors need 0 < ks ≤ ka ≤ 1, got ka {} and ks {}",
+                    p.ka, p.ks
+                ),
+            ));
+        }
+        if !(p.floor > 0.0 && p.floor <= 1.0) {
+            return Err(cfg(
+                "contact.polach.floor".into(),
+                format!(
+                    "the friction at infinite slip over the static lies in (0, 1], got {}",
+                    p.floor
+                ),
+            ));
+        }
+        if !(p.decay_s_per_m >= 0.0 && p.decay_s_per_m.is_finite()) {
+            return Err(cfg(
+                "contact.polach.decay_s_per_m".into(),
+                format!("must be ≥ 0 s/m, got {}", p.decay_s_per_m),
+            ));
+        }
+        law = CreepLaw::Polach(crate::contact::PolachParams {
+            ka: p.ka,
+            ks: p.ks,
+            floor: p.floor,
+            decay: p.decay_s_per_m,
+        });
+    }
+    let flange_friction = c.flange_friction.unwrap_or(c.friction);
+    if !(flange_friction > 0.0 && flange_friction < 1.0) {
+        return Err(cfg(
+            "contact.flange_friction".into(),
+            format!("must lie in (0, 1), got {flange_friction}"),
+        ));
+    }
     let accelerometers = match &raw.accelerometers {
         None => Accelerometers::default(),
         Some(a) => Accelerometers::parse(a).ok_or_else(|| {
@@ -285,6 +351,7 @@ pub(super) fn load_edited(
             wheelsets,
             geometry,
             friction: c.friction,
+            flange_friction,
             law,
             material: Material {
                 young: c.young_pa,

@@ -29,6 +29,9 @@ pub struct ContactSettings {
     pub geometry: WheelsetGeometry,
     /// Friction coefficient.
     pub friction: f64,
+    /// Friction coefficient on the rail's gauge face (the flange's; the tread's unless the
+    /// file or the condition's `gauge_face` says otherwise).
+    pub flange_friction: f64,
     /// Creep force law.
     pub law: CreepLaw,
     /// Elastic constants.
@@ -53,6 +56,7 @@ impl ContactSettings {
         crate::contact::ContactModel {
             material: self.material,
             friction: self.friction,
+            flange_friction: self.flange_friction,
             law: self.law,
             damping_ratio: self.damping_ratio,
         }

@@ -58,7 +58,7 @@ pub fn run(vehicle: &Vehicle, iterations: usize) -> ContactBench {
         black_box(acc);
         t.elapsed().as_secs_f64() * 1e9 / n as f64
     };
-    let wheel_polach_ns = time_wheel(CreepLaw::Polach, iterations);
+    let wheel_polach_ns = time_wheel(CreepLaw::default(), iterations);
     let wheel_fastsim_ns = time_wheel(CreepLaw::Fastsim { n: 60 }, (iterations / 200).max(10));
     let n_solve = (iterations / 5000).max(5);
     let t = Instant::now();

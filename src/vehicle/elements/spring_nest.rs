@@ -427,7 +427,10 @@ mod tests {
         let scale = nest(NestStaging::Potential).law.energy(0.07);
         let w = work_over_cycle(&nest(NestStaging::Potential), &cycle);
         // Seating may lose energy, never make it.
-        assert!(w <= 1e-6 * scale, "potential form made {w} J (scale {scale} J)");
+        assert!(
+            w <= 1e-6 * scale,
+            "potential form made {w} J (scale {scale} J)"
+        );
         // Within one stage (all quarters past the inner gap) the element is conservative.
         let within = |t: f64| {
             let (c, y, roll) = cycle(t);

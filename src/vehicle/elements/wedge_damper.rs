@@ -446,7 +446,10 @@ mod tests {
             // Loading: the side frame rises against the bolster (the bolster moves down on it),
             // the friction on the bolster acts up.
             let up = sliding_force_ratio(&w, 0.005);
-            assert!((up - exact_load).abs() < 1e-9, "loading {up} vs {exact_load}");
+            assert!(
+                (up - exact_load).abs() < 1e-9,
+                "loading {up} vs {exact_load}"
+            );
             let down = sliding_force_ratio(&w, -0.005);
             assert!(
                 (down + exact_unload).abs() < 1e-9,
