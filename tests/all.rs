@@ -36,6 +36,8 @@ mod identify;
 mod integrator;
 #[path = "learn.rs"]
 mod learn;
+#[path = "line.rs"]
+mod line;
 #[path = "mutation.rs"]
 mod mutation;
 #[path = "mutation_commands.rs"]

@@ -86,7 +86,7 @@ fn track_summary_export_and_psd() {
         psd.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
-    assert!(out.contains("balance speed 79.8 km/h"), "{out}");
+    assert!(out.contains("balance speed 71.3 km/h"), "{out}");
     assert!(out.contains("formula RMS"), "{out}");
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();

@@ -32,11 +32,12 @@ fn side_bearer_goes_solid_beyond_its_travel() {
             _ => None,
         })
         .unwrap();
-    assert_eq!(sb.travel, 5e-3);
+    // Miner TCC-III-LT's 5/8 in long travel.
+    assert_eq!(sb.travel, 0.0159);
     let (p, k, ks) = (sb.preload, sb.stiffness, sb.stop_stiffness);
     assert!((sb.vertical_force(3e-3) - (p + k * 3e-3)).abs() < 1e-6);
-    let d = 7e-3;
-    assert!((sb.vertical_force(d) - (p + k * d + ks * (d - 5e-3))).abs() < 1e-6);
+    let d = 18e-3;
+    assert!((sb.vertical_force(d) - (p + k * d + ks * (d - 0.0159))).abs() < 1e-6);
     assert_eq!(sb.vertical_force(-1.0), 0.0);
 }
 

@@ -258,12 +258,12 @@ fn curve_geometry_cant_ramp_and_balance_speed() {
         SectionKind::Curve { radius, cant, .. } => (radius, cant),
         _ => panic!("section 2 is the curve"),
     };
-    assert_eq!((radius, cant), (400.0, 0.188));
+    assert_eq!((radius, cant), (400.0, 0.150));
     // Right-hand curve: negative curvature, left rail raised (positive signed cant).
     let mid = t.at(curve.start + 0.5 * curve.length);
     assert!((mid.curvature + 1.0 / radius).abs() < 1e-12);
     assert!((mid.cant - cant).abs() < 1e-12);
-    assert!((mid.cant_angle - (0.188f64 / 1.5).asin()).abs() < 1e-12);
+    assert!((mid.cant_angle - (0.150f64 / 1.5).asin()).abs() < 1e-12);
     // Three points on the circular part lie on a circle of radius R.
     let (p1, p2, p3) = (
         t.at(curve.start + 100.0),
@@ -288,13 +288,13 @@ fn curve_geometry_cant_ramp_and_balance_speed() {
     let out = spec.sections[3];
     let p = t.at(out.start + 0.25 * out.length);
     assert!((p.cant - 0.75 * cant).abs() < 1e-9);
-    // Balance speed sqrt(g R h / s) = 79.8 km/h for R 400 m, 188 mm.
+    // Balance speed sqrt(g R h / s) = 71.3 km/h for R 400 m, 150 mm.
     let v_eq = curve.balance_speed(spec.rail_spacing).unwrap();
-    assert!((v_eq - (9.81f64 * 400.0 * 0.188 / 1.5).sqrt()).abs() < 1e-12);
-    assert!((v_eq * 3.6 - 79.8).abs() < 0.05);
+    assert!((v_eq - (9.81f64 * 400.0 * 0.150 / 1.5).sqrt()).abs() < 1e-12);
+    assert!((v_eq * 3.6 - 71.3).abs() < 0.05);
     assert!(spec.sections[0].balance_speed(1.5).is_none());
-    let a_nc = railforce::track::cant_deficiency_acceleration(60.0 / 3.6, 400.0, 0.188, 1.5);
-    assert!((a_nc - (277.777_777_777_777_8 / 400.0 - 9.81 * 0.188 / 1.5)).abs() < 1e-12);
+    let a_nc = railforce::track::cant_deficiency_acceleration(60.0 / 3.6, 400.0, 0.150, 1.5);
+    assert!((a_nc - (277.777_777_777_777_8 / 400.0 - 9.81 * 0.150 / 1.5)).abs() < 1e-12);
 }
 
 fn circumradius(a: (f64, f64), b: (f64, f64), c: (f64, f64)) -> f64 {

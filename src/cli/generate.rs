@@ -104,8 +104,14 @@ pub fn run(args: GenerateArgs) -> Result<()> {
             args.out.display()
         );
     } else {
+        let dropped = manifest.dropped.len();
+        let dropped_text = if dropped > 0 {
+            format!(" ({dropped} of them derailed and dropped: the manifest lists where)")
+        } else {
+            String::new()
+        };
         println!(
-            "{runs} runs in {} ({} format): {generated} generated, {skipped} skipped (already done), {:.1} s with {jobs} jobs; manifest: {}",
+            "{runs} runs in {} ({} format): {generated} generated{dropped_text}, {skipped} skipped (already done), {:.1} s with {jobs} jobs; manifest: {}",
             args.out.display(),
             format.ext(),
             t0.elapsed().as_secs_f64(),

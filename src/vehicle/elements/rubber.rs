@@ -49,7 +49,7 @@ impl Rubber {
             atb += row * eta;
         }
         let k = ata.lu().solve(&atb)?;
-        if k.iter().any(|&w| !(w >= 0.0)) {
+        if k.iter().any(|&w| w.is_nan() || w < 0.0) {
             return None;
         }
         Some(Rubber {
@@ -77,9 +77,9 @@ impl Rubber {
     #[inline]
     pub fn branch_force(&self, k0: f64, x: f64, u: &mut [f64], dt: f64) -> f64 {
         let mut f = 0.0;
-        for i in 0..BRANCHES {
-            f += self.weights[i] * k0 * (x - u[i]);
-            u[i] = x + (u[i] - x) * (-dt / self.tau[i]).exp();
+        for ((w, tau), u) in self.weights.iter().zip(&self.tau).zip(u.iter_mut()) {
+            f += w * k0 * (x - *u);
+            *u = x + (*u - x) * (-dt / tau).exp();
         }
         f
     }
