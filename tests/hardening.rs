@@ -298,3 +298,34 @@ fn a_weight_that_is_not_finite_is_refused_by_index() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A mode stiffer than the step chatters with the state bounded: the C80's pads 20 % stiffer
+/// with their rubber's loss factor put the side frames past the 5/6 ms step, the wheel loads
+/// jump by hundreds of kN from step to step, and the run stops saying so (the nominal pads run).
+#[test]
+fn a_chattering_run_is_stopped_and_named() {
+    use railforce::vehicle::Vehicle;
+    use railforce::vehicle::elements::Element;
+    let mut v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
+    for e in &mut v.elements {
+        if let Element::ShearPad(p) = e {
+            p.stiffness *= 1.2;
+        }
+    }
+    let track = railforce::sim::fidelity::smooth(&root().join("tracks/tangent.toml")).unwrap();
+    let cfg = railforce::sim::SimConfig {
+        speed: 22.0,
+        duration: 1.0,
+        settle: 2.0,
+        ..Default::default()
+    };
+    let mut sim = railforce::sim::Simulation::new(&v, &track, cfg).unwrap();
+    let e = railforce::sim::output::record(&mut sim, |_| {})
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("simulation diverged") && e.contains("chatters") && e.contains("wheel "),
+        "{e}"
+    );
+}

@@ -153,6 +153,11 @@ pub struct Simulation<'a> {
     inputs: Vec<crate::contact::WheelOnRail>,
     /// Per wheel: how long Y/Q has exceeded the Nadal limit, s.
     over_nadal: Vec<f64>,
+    /// Per wheel: the last step's wheel load and the sum of squared step-to-step changes of
+    /// it since the chatter window opened (`watch`), N and N².
+    chatter: Vec<(f64, f64)>,
+    /// Each wheel's static share of the weight, N.
+    static_load: f64,
     hauling_integral: f64,
     /// The train the carbody is coupled into, when the run has one.
     hitch: Option<Box<hitch::Hitch>>,
@@ -359,6 +364,8 @@ impl<'a> Simulation<'a> {
             shares: cfg.integrator.shares(cfg.dt),
             inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
+            chatter: vec![(static_load, 0.0); n_wheels],
+            static_load,
             hauling_integral: 0.0,
             time: -cfg.settle,
             flange_height: {

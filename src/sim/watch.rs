@@ -1,5 +1,18 @@
 //! The run's watch, every step: a non-finite state (before anything looks the track up with
-//! it), runaway motion and derailment end the run with the time, the body or wheel and why.
+//! it), runaway motion, chatter and derailment end the run with the time, the body or wheel
+//! and why.
+//!
+//! Chatter is a mode stiffer than the step follows, oscillating from step to step while the
+//! state stays bounded: the wheel loads then jump by hundreds of kN from one step to the next.
+//! A sound run's wheel loads change by up to about 20 kN rms from step to step (the C80 on
+//! R 400 m at 100 km/h, class 5: the wheel–rail mode, far above the recorded band), a
+//! chattering one by over 1 MN (its pads 20 % stiffer than the step takes), so an rms
+//! step-to-step change above half the static wheel load over a second ends the run.
+
+/// Window of the chatter check, s.
+const CHATTER_WINDOW: f64 = 1.0;
+/// Largest rms step-to-step change of a wheel load over the window, in static wheel loads.
+const CHATTER_LIMIT: f64 = 0.5;
 
 use super::{Simulation, wheel_name};
 use crate::error::{Error, Result};
@@ -53,6 +66,29 @@ impl Simulation<'_> {
                     self.time,
                     rel_v.norm()
                 )));
+            }
+        }
+        // Chatter: each wheel's step-to-step load change, its rms over each window.
+        let window = (CHATTER_WINDOW / self.cfg.dt).round().max(1.0) as u64;
+        for (k, w) in self.wheels.iter().enumerate() {
+            let (last, sum) = &mut self.chatter[k];
+            *sum += (w.q - *last).powi(2);
+            *last = w.q;
+        }
+        if self.step_count.is_multiple_of(window) {
+            for k in 0..self.chatter.len() {
+                let rms = (self.chatter[k].1 / window as f64).sqrt();
+                self.chatter[k].1 = 0.0;
+                if rms > CHATTER_LIMIT * self.static_load {
+                    return Err(Error::Domain(format!(
+                        "simulation diverged at t = {:.3} s: wheel {}'s load jumped by {:.1} kN rms from step to step over the last {CHATTER_WINDOW} s (more than half its static {:.1} kN): a mode stiffer than the {:.3} ms step chatters (a stiffer element, a rubber with more loss, or a longer step than the vehicle takes)",
+                        self.time,
+                        wheel_name(k),
+                        rms / 1e3,
+                        self.static_load / 1e3,
+                        self.cfg.dt * 1e3
+                    )));
+                }
             }
         }
         let limit = self.nadal_limit;
