@@ -7,7 +7,7 @@
 //! "vehicle.contact.friction" = { uniform = [0.15, 0.5] }                # wet to dry rail
 //! "vehicle.body.carbody.mass" = { uniform = [0.5, 1.0], scale = true,   # part-loaded
 //!                                 with = ["vehicle.body.carbody.inertia"] }
-//! "vehicle.shear_pad.stiffness" = { uniform = [0.8, 1.2], scale = true } # every pad, x y z
+//! "vehicle.shear_pad.stiffness" = { uniform = [0.8, 1.1], scale = true } # every pad, x y z
 //! "track.irregularity.class" = { one_of = [4, 5, 6] }
 //! "speed_kmh" = { normal = [80.0, 5.0] }                                # truncated at ±3σ
 //! ```
