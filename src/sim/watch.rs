@@ -3,19 +3,22 @@
 //! and why.
 //!
 //! Chatter is a mode stiffer than the step follows, oscillating from step to step while the
-//! state stays bounded: the wheel loads then jump by hundreds of kN from one step to the next.
-//! A sound run's wheel loads change by up to about 20 kN rms from step to step (the C80 on
-//! R 400 m at 100 km/h, class 5: the wheel–rail mode, far above the recorded band; the empty
-//! C80 hunting at 200 km/h on high-conicity wheels 59 kN, its flanges striking; a hunting
-//! restrained wheelset its whole static load), a chattering one by 266 kN with its pads 15 %
-//! stiffer than the step takes and 1.2 MN at 20 %. So an rms step-to-step change over a
-//! second above one and a half static wheel loads, and above 100 kN, ends the run.
+//! state stays bounded: the wheel loads then jump by many times their static load from one
+//! step to the next. The C80 with its pads 20 % stiffer than the step takes chatters at
+//! 1.2 MN rms (ten static loads) from the start; a sound run's wheel loads change by about
+//! 20 kN rms from step to step (R 400 m at 100 km/h, class 5: the wheel–rail mode, far above
+//! the recorded band). Between lie runs whose contact outruns the step in bursts: a
+//! three-quarter-loaded C80 hunting at 100 km/h on class-4 track, |Y/Q| peaking at 2.5,
+//! 154–289 kN (1.6–3 static loads) while flanges strike; pads 15 % stiffer, 266 kN. An rms
+//! step-to-step change over a second above four static wheel loads, and above 100 kN, ends
+//! the run: that is gross chatter. The bursts below it are not caught here; the shipped fleet
+//! and estimates keep the pads where the step holds them (physics.md §2).
 
 /// Window of the chatter check, s.
 const CHATTER_WINDOW: f64 = 1.0;
 /// Largest rms step-to-step change of a wheel load over the window, in static wheel loads,
 /// and never below [`CHATTER_FLOOR`].
-const CHATTER_LIMIT: f64 = 1.5;
+const CHATTER_LIMIT: f64 = 4.0;
 /// Smallest chatter limit, N (light vehicles' loads swing by more than their whole load when
 /// they hunt).
 const CHATTER_FLOOR: f64 = 100e3;
@@ -87,7 +90,7 @@ impl Simulation<'_> {
                 self.chatter[k].1 = 0.0;
                 if rms > (CHATTER_LIMIT * self.static_load).max(CHATTER_FLOOR) {
                     return Err(Error::Domain(format!(
-                        "simulation diverged at t = {:.3} s: wheel {}'s load jumped by {:.1} kN rms from step to step over the last {CHATTER_WINDOW} s (more than 1.5 times its static {:.1} kN, and more than 100 kN): a mode stiffer than the {:.3} ms step chatters (a stiffer element, a rubber with more loss, or a longer step than the vehicle takes)",
+                        "simulation diverged at t = {:.3} s: wheel {}'s load jumped by {:.1} kN rms from step to step over the last {CHATTER_WINDOW} s (more than four times its static {:.1} kN, and more than 100 kN): a mode stiffer than the {:.3} ms step chatters (a stiffer element, a rubber with more loss, or a longer step than the vehicle takes)",
                         self.time,
                         wheel_name(k),
                         rms / 1e3,
