@@ -71,15 +71,23 @@ impl Rubber {
         (re, im)
     }
 
+    /// The branches' relaxation over a step `dt`, `e^(−Δt/τᵢ)`: the same for every chain
+    /// (the relaxation times are fixed), so an element computes it once a step.
+    #[inline]
+    pub fn decays(&self, dt: f64) -> [f64; BRANCHES] {
+        self.tau.map(|tau| (-dt / tau).exp())
+    }
+
     /// Force of the branches (N, the static spring's aside) at deflection `x` over static
     /// stiffness `k0`; `u` holds the branches' dashpot positions and moves to the step's end,
-    /// exactly for `x` held over `dt`: `u ← x + (u − x)·e^(−Δt/τ)`.
+    /// exactly for `x` held over the step whose [`Self::decays`] are `decay`:
+    /// `u ← x + (u − x)·e^(−Δt/τ)`.
     #[inline]
-    pub fn branch_force(&self, k0: f64, x: f64, u: &mut [f64], dt: f64) -> f64 {
+    pub fn branch_force(&self, k0: f64, x: f64, u: &mut [f64], decay: &[f64; BRANCHES]) -> f64 {
         let mut f = 0.0;
-        for ((w, tau), u) in self.weights.iter().zip(&self.tau).zip(u.iter_mut()) {
+        for ((w, d), u) in self.weights.iter().zip(decay).zip(u.iter_mut()) {
             f += w * k0 * (x - *u);
-            *u = x + (*u - x) * (-dt / tau).exp();
+            *u = x + (*u - x) * d;
         }
         f
     }
@@ -122,7 +130,7 @@ mod tests {
             for i in 0..=steps {
                 let t = i as f64 * dt;
                 let x = x0 * (w * t).sin();
-                let force = k0 * x + r.branch_force(k0, x, &mut u, dt);
+                let force = k0 * x + r.branch_force(k0, x, &mut u, &r.decays(dt));
                 // The last two cycles, once the branches have settled.
                 if i > 4000 * (cycles - 2) {
                     e += 0.5 * (force + prev_f) * (x - prev_x);

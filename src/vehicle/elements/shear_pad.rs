@@ -88,10 +88,12 @@ impl ShearPad {
         let mut f = self.stiffness.component_mul(&r.d)
             + self.damping.component_mul(&r.v)
             + Vector3::new(0.0, 0.0, self.preload);
-        if let Some(rubber) = &self.rubber {
+        // The branches' relaxation over the step, once for the pad's four chains.
+        let decay = self.rubber.as_ref().map(|r| r[0].decays(dt));
+        if let (Some(rubber), Some(decay)) = (&self.rubber, &decay) {
             for (i, rb) in rubber.iter().enumerate() {
                 let u = &mut memory[i * BRANCHES..(i + 1) * BRANCHES];
-                f[i] += rb.branch_force(self.stiffness[i], r.d[i], u, dt);
+                f[i] += rb.branch_force(self.stiffness[i], r.d[i], u, decay);
             }
         }
         r.apply(f, &self.upper, &self.lower, states, wrenches);
@@ -113,16 +115,16 @@ impl ShearPad {
             let w_lower = sl.angular_velocity - axle * sl.angular_velocity.dot(&axle);
             let x_upper = r.axes.column(0).into_owned();
             let theta_dot = (su.angular_velocity - w_lower).dot(&x_upper);
-            let m = match &self.rubber {
-                None => self.rocking_moment(theta, theta_dot, f.z),
-                Some(rubber) => {
+            let m = match (&self.rubber, &decay) {
+                (Some(rubber), Some(decay)) => {
                     // The vertical axis' rubber over the bed: static `k_z·w²/12` and its
                     // branches, no more than the load tipping on an edge.
                     let u = &mut memory[3 * BRANCHES..4 * BRANCHES];
                     let k = self.rocking_stiffness();
                     let tip = 0.5 * self.width * f.z.max(0.0);
-                    (k * theta + rubber[2].branch_force(k, theta, u, dt)).clamp(-tip, tip)
+                    (k * theta + rubber[2].branch_force(k, theta, u, decay)).clamp(-tip, tip)
                 }
+                _ => self.rocking_moment(theta, theta_dot, f.z),
             };
             wrenches[self.upper.body].torque -= x_upper * m;
             wrenches[self.lower.body].torque += x_upper * m;
