@@ -6,6 +6,7 @@
 
 mod alignment;
 pub mod check;
+pub mod discrete;
 mod file;
 pub mod irregularity;
 mod profile;

@@ -1,0 +1,180 @@
+//! The discrete track against closed forms: the Winkler beam under one and two static loads,
+//! a load moving below the critical speed, the window's shift.
+
+use super::*;
+
+/// Both rails loaded alike at `s` (a wheelset's two wheels), `p` N down each.
+fn pair(s: f64, p: f64) -> [Load; 2] {
+    [0, 1].map(|side| Load {
+        side,
+        s,
+        lateral: 0.0,
+        vertical: -p,
+    })
+}
+
+fn settled(p: DiscreteSupport, centre: f64, loads: &[Load]) -> TrackDynamics {
+    let mut t = TrackDynamics::new(p, centre);
+    t.settle(5e-4, 1.5, loads);
+    t
+}
+
+/// Without shear between the ballast blocks the discrete track is a beam on springs every
+/// 0.6 m: the Winkler beam with the seat stiffness smeared over the spacing, β = 1.154 /m.
+/// Under the load (over a sleeper and at mid-span) and along the basin within 3 % of the
+/// closed form's peak.
+#[test]
+fn static_load_matches_the_winkler_beam() {
+    let p = DiscreteSupport {
+        ballast_shear: KelvinVoigt {
+            stiffness: 0.0,
+            damping: 0.0,
+        },
+        ..DiscreteSupport::default()
+    };
+    assert!((p.beta() - 1.154).abs() < 2e-3, "β = {}", p.beta());
+    let load = 100e3;
+    let w0 = p.winkler_deflection(load, 0.0);
+    for s in [12.0, 12.3] {
+        let mut t = settled(p, 12.0, &pair(s, load));
+        for x in [-3.0, -1.8, -1.2, -0.6, 0.0, 0.3, 0.9, 1.5, 2.4, 3.0] {
+            let w = -t.rail(0, s + x)[2];
+            let closed = p.winkler_deflection(load, x);
+            assert!(
+                (w - closed).abs() < 0.03 * w0,
+                "load at {s} m, {x} m from it: {w:e} m against {closed:e} m"
+            );
+        }
+        // At rest, both rails alike.
+        let l = t.rail(0, s);
+        let r = t.rail(1, s);
+        assert!((l[2] - r[2]).abs() < 1e-12 && l[3].abs() < 1e-9);
+    }
+}
+
+/// Two wheels 1.83 m apart: the track is linear, so the basin is the sum of the two single
+/// basins (to 0.1 %), and it stays within 3 % of the Winkler beam's superposition.
+#[test]
+fn two_loads_superpose() {
+    let p = DiscreteSupport::default();
+    let (a, b, load) = (12.0, 13.83, 100e3);
+    let both = [pair(a, load), pair(b, load)].concat();
+    let mut t = settled(p, 12.9, &both);
+    let mut ta = settled(p, 12.9, &pair(a, load));
+    let mut tb = settled(p, 12.9, &pair(b, load));
+    for x in [10.0, 11.4, 12.0, 12.9, 13.83, 14.5, 16.0] {
+        let w = t.rail(0, x)[2];
+        let sum = ta.rail(0, x)[2] + tb.rail(0, x)[2];
+        assert!(
+            (w - sum).abs() < 1e-3 * sum.abs().max(1e-4),
+            "{x} m: {w} against {sum}"
+        );
+    }
+    // With shear the ballast spreads the load: the basin is stiffer than Winkler's.
+    let under = -t.rail(0, a)[2];
+    let closed = p.winkler_deflection(load, 0.0) + p.winkler_deflection(load, b - a);
+    assert!(
+        under < closed && under > 0.8 * closed,
+        "{under} against {closed}"
+    );
+    let p = DiscreteSupport {
+        ballast_shear: KelvinVoigt {
+            stiffness: 0.0,
+            damping: 0.0,
+        },
+        ..p
+    };
+    let mut t = settled(p, 12.9, &both);
+    for x in [12.0, 12.9, 13.83] {
+        let w = -t.rail(0, x)[2];
+        let closed = p.winkler_deflection(load, x - a) + p.winkler_deflection(load, x - b);
+        assert!(
+            (w - closed).abs() < 0.03 * closed,
+            "{x} m: {w} against {closed}"
+        );
+    }
+}
+
+/// A load moving at 100 km/h (well below the critical speed, about 760 m/s) carries its
+/// static basin with it: the deflection under it stays within 2 % of the static one over
+/// 20 m, through 33 shifts of the window, and changes smoothly from step to step.
+#[test]
+fn moving_load_below_critical_speed_carries_its_basin() {
+    let p = DiscreteSupport::default();
+    assert!(
+        (p.critical_speed() - 760.0).abs() < 20.0,
+        "{}",
+        p.critical_speed()
+    );
+    let (load, v, dt) = (100e3, 100.0 / 3.6, 5e-4);
+    let mut t = settled(p, 0.0, &pair(0.0, load));
+    let statics = -t.rail(0, 0.0)[2];
+    let mut s: f64 = 0.0;
+    let mut last = statics;
+    let start = t.start();
+    while s < 20.0 {
+        s += v * dt;
+        t.recentre(s);
+        t.step(dt, &pair(s, load));
+        let w = -t.rail(0, s)[2];
+        assert!(w.is_finite());
+        assert!(
+            (w - last).abs() < 0.01 * statics,
+            "jump at {s} m: {last} → {w}"
+        );
+        last = w;
+        if s > 5.0 {
+            assert!(
+                (w / statics - 1.0).abs() < 0.02,
+                "{s} m: {w} against {statics}"
+            );
+        }
+    }
+    assert!(((t.start() - start) / p.spacing).round() >= 33.0);
+}
+
+/// A free track released from a displaced state loses energy: the rails come back to rest
+/// (no step-made energy at the default 5/6 ms step, whose explicit parts are the sleepers'
+/// and the ballast's neighbours).
+#[test]
+fn released_track_comes_to_rest_at_the_default_step() {
+    let p = DiscreteSupport::default();
+    let mut t = settled(p, 12.0, &pair(12.0, 150e3));
+    let lateral = [0, 1].map(|side| Load {
+        side,
+        s: 12.0,
+        lateral: 40e3,
+        vertical: 0.0,
+    });
+    t.settle(5e-4, 0.5, &lateral);
+    let dt = 1.0 / 1200.0;
+    let mut peak = [0.0f64; 2];
+    for i in 0..2400 {
+        t.step(dt, &[]);
+        let r = t.rail(0, 12.0);
+        assert!(r.iter().all(|x| x.is_finite()));
+        if i > 1200 {
+            peak[0] = peak[0].max(r[0].abs());
+            peak[1] = peak[1].max(r[2].abs());
+        }
+    }
+    assert!(peak[0] < 1e-6 && peak[1] < 1e-6, "{peak:?}");
+}
+
+#[test]
+fn file_errors_name_the_key() {
+    let f: DiscreteFile = toml::from_str("ballast_stiffness_n_per_m = -1.0").unwrap();
+    let e = f.support("t.toml".as_ref()).unwrap_err().to_string();
+    assert!(
+        e.contains("t.toml") && e.contains("rail_support.discrete.ballast_stiffness_n_per_m"),
+        "{e}"
+    );
+    let f: DiscreteFile = toml::from_str("window_bays = 20").unwrap();
+    let e = f.support("t.toml".as_ref()).unwrap_err().to_string();
+    assert!(e.contains("window_bays") && e.contains("20 m"), "{e}");
+    assert!(toml::from_str::<DiscreteFile>("ballast_stifness_n_per_m = 1.0").is_err());
+    assert_eq!(
+        DiscreteFile::default().support("t.toml".as_ref()).unwrap(),
+        DiscreteSupport::default()
+    );
+}
