@@ -348,6 +348,10 @@ impl Simulation<'_> {
         } else {
             du
         };
+        if self.beams.is_some() {
+            let d = *d;
+            return self.wheelset_on_beams(k, body, &d, du, &surface);
+        }
         match self.track.spec().rail_support {
             None => {
                 let mut a = d * (THETA * dt);

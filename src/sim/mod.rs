@@ -24,6 +24,7 @@ mod integrator;
 pub mod modes;
 pub mod output;
 pub mod profile;
+mod rail_beams;
 mod request;
 mod track_frame;
 mod watch;
@@ -187,6 +188,10 @@ pub struct Simulation<'a> {
     damped: Vec<element_solve::DampedBody>,
     /// Per body: the reaction impulse of that damping in the current step, world.
     kicks: Vec<nalgebra::Vector6<f64>>,
+    /// The rails on discrete sleepers, when the track has them.
+    beams: Option<Box<crate::track::discrete::TrackDynamics>>,
+    /// Per wheel: its impulse on the beams in the last step, lateral and vertical, N·s.
+    beam_impulses: Vec<nalgebra::Vector2<f64>>,
 }
 
 impl<'a> Simulation<'a> {
@@ -261,10 +266,30 @@ impl<'a> Simulation<'a> {
         let centred = table.lookup(0.0);
         // The rails sink under the static load on a compliant track; the wheelsets sit at the
         // height where each wheel carries its share (the run's own contact evaluation).
-        let rail_z0 = track
-            .spec()
-            .rail_support
-            .map_or(0.0, |s| -static_load / s.vertical.stiffness);
+        // On sleepers the track settles under the static loads first (the integrators that
+        // take the rails' step mobility into the wheelsets' solve only).
+        let beams = match track.spec().discrete_rails {
+            None => None,
+            Some(p) => {
+                if cfg.integrator.shares(cfg.dt).is_none() {
+                    return Err(Error::Domain(format!(
+                        "track '{}' has rails on discrete sleepers: they run with the linearly implicit integrators (linearly-implicit-hertz, the default, or linearly-implicit), not {:?}",
+                        track.spec().name,
+                        cfg.integrator
+                    )));
+                }
+                let ws: Vec<f64> = (vehicle.contact.wheelsets.iter())
+                    .map(|&w| start + vehicle.bodies[w].position.x)
+                    .collect();
+                Some(rail_beams::settled(p, &ws, static_load, cfg.dt))
+            }
+        };
+        let rail_z0 = match &beams {
+            Some((_, sag)) => *sag,
+            None => {
+                (track.spec().rail_support).map_or(0.0, |s| -static_load / s.vertical.stiffness)
+            }
+        };
         let ws_mass = vehicle.bodies[vehicle.contact.wheelsets[0]].mass;
         let rest = crate::contact::WheelOnRail::rolling(
             crate::contact::Side::Left,
@@ -335,7 +360,8 @@ impl<'a> Simulation<'a> {
                 ));
             }
         };
-        Ok(Simulation {
+        let dt0 = cfg.dt;
+        let mut sim = Simulation {
             hitch,
             frames,
             every_step,
@@ -361,7 +387,12 @@ impl<'a> Simulation<'a> {
             surface_rates: vec![None; n_wheels],
             damped,
             kicks: vec![nalgebra::Vector6::zeros(); n],
-            shares: cfg.integrator.shares(cfg.dt),
+            shares: cfg.integrator.shares(cfg.dt).map(|mut s| {
+                if beams.is_some() && s.alpha_dt > 0.0 {
+                    s.alpha_dt = wheelset_solve::ALPHA_ON_BEAMS * cfg.dt;
+                }
+                s
+            }),
             inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
             chatter: vec![(static_load, 0.0); n_wheels],
@@ -385,7 +416,11 @@ impl<'a> Simulation<'a> {
             wheels: vec![WheelResult::default(); n_wheels],
             accelerations: vec![Vector3::zeros(); n],
             profile: None,
-        })
+            beams: beams.map(|(b, _)| b),
+            beam_impulses: vec![nalgebra::Vector2::new(0.0, -static_load * dt0); n_wheels],
+        };
+        sim.rails_from_beams();
+        Ok(sim)
     }
 
     /// Simulated time, s (negative while settling).
@@ -475,6 +510,9 @@ impl<'a> Simulation<'a> {
         timed!(self.profile, "rails", self.move_rails());
         let t0 = self.profile.is_some().then(std::time::Instant::now);
         self.integrate();
+        if let Some(b) = self.beams.as_deref_mut() {
+            b.end(dt);
+        }
         if let (Some(t0), Some(p)) = (t0, self.profile.as_deref_mut()) {
             p.add("integration (11 bodies)", t0.elapsed());
             p.steps += 1;
@@ -525,6 +563,7 @@ impl<'a> Simulation<'a> {
                 }
             }
         });
+        timed!(self.profile, "rails", self.rails_from_beams());
         timed!(self.profile, "contact (8 wheels)", self.contact())?;
         if self.hitch.is_some() {
             timed!(self.profile, "train", self.pull(integrate_haul));

@@ -183,6 +183,10 @@ impl Simulation<'_> {
     /// Moves the rail masses one step under the wheels' reactions (compliant track only; the
     /// linearly implicit step moves them with their wheelset in `integrate`).
     pub(super) fn move_rails(&mut self) {
+        if self.beams.is_some() {
+            self.begin_beams();
+            return;
+        }
         let Some(sup) = self.track.spec().rail_support else {
             return;
         };

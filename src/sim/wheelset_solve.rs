@@ -135,6 +135,17 @@ pub(super) const THETA: f64 = 0.5;
 /// conditions 1.0–1.7 % off in Q's standard deviation already at 5/7 ms.
 pub(super) const ALPHA: f64 = 0.15;
 
+/// The Hertz spring's share `α` when the rails are beams on sleepers
+/// ([`crate::track::discrete`]). Under a wheel the beam's inertia over a step is its modes'
+/// mass alone, about 37 kg at the default step (the rest of its step mass, 263 kg, is the
+/// modes' stiffness taken implicitly), so the wheel–rail mode runs at ω·Δt ≈ 5.7, beyond
+/// α = 0.15's limit of 3.16: with it, R 400 m at 60 km/h burst within a second of settling
+/// at any step from 0.8 ms, and held at 0.75 ms. α = ¼ is the average acceleration's,
+/// stable at any step for a linear spring; it puts that mode (P1, above 1 kHz on such a
+/// track) near 360 Hz at the default step, far above the recorded 100 Hz band (an estimate
+/// from `ω̃² = ω²/(1 + α·ω²·Δt²)`). A wagon on beams needs a step near 0.1 ms to follow P1.
+pub(super) const ALPHA_ON_BEAMS: f64 = 0.25;
+
 /// How the linearly implicit solve takes the contact at step `dt`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Shares {
@@ -192,6 +203,37 @@ pub(super) fn with_rails(
     sup: &crate::track::RailSupport,
 ) -> Vector6<f64> {
     let (m, ks, cs) = rail_matrices(sup);
+    let blocks = std::array::from_fn(|side| {
+        let (rail, c, f) = (&rails[side], &coupling[side], rail_force[side]);
+        let (xv, vv) = (Vector2::new(rail.y, rail.z), Vector2::new(rail.vy, rail.vz));
+        let l = m + (c.damping * THETA + cs) * dt + ks * (dt * dt);
+        let mut r = (Vector2::from(f) - ks * (xv + vv * dt) - cs * vv) * dt;
+        if surface[side] != Vector2::zeros() {
+            r -= c.surface_on_rail * surface[side];
+        }
+        (l, r)
+    });
+    let (du, dv) = with_rail_rows(body, d, du, dt, coupling, blocks);
+    for (rail, dv) in rails.iter_mut().zip(dv) {
+        rail.vy += dv.x;
+        rail.vz += dv.y;
+        rail.y += rail.vy * dt;
+        rail.z += rail.vz * dt;
+    }
+    du
+}
+
+/// The wheelset's solve with each rail's rows `L_k·Δr_k − θΔt·Pᵀ·D_k·Δu = r_k` (`blocks`:
+/// `(L_k, r_k)`, track axes; the rails' velocity change `Δr_k`): the wheelset's velocity
+/// change and both rails'.
+pub(super) fn with_rail_rows(
+    body: &Inverse,
+    d: &Matrix6<f64>,
+    du: Vector6<f64>,
+    dt: f64,
+    coupling: &[RailCoupling],
+    blocks: [(Matrix2<f64>, Vector2<f64>); 2],
+) -> (Vector6<f64>, [Vector2<f64>; 2]) {
     let mut a = d * (THETA * dt);
     body.apply(&mut a);
     let mut g = a.fixed_view_mut::<3, 3>(3, 3);
@@ -206,31 +248,18 @@ pub(super) fn with_rails(
         SMatrix::<f64, 2, 6>::zeros(),
         Vector2::zeros(),
     ); 2];
-    for side in 0..2 {
-        let (rail, c, f) = (&rails[side], &coupling[side], rail_force[side]);
+    for (side, (l, r)) in blocks.into_iter().enumerate() {
+        let c = &coupling[side];
         let mut x = -c.from_rail * (THETA * dt);
         body.apply(&mut x);
         let y = -c.to_rail * (THETA * dt);
-        let (xv, vv) = (Vector2::new(rail.y, rail.z), Vector2::new(rail.vy, rail.vz));
-        let l = m + (c.damping * THETA + cs) * dt + ks * (dt * dt);
-        let mut r = (Vector2::from(f) - ks * (xv + vv * dt) - cs * vv) * dt;
-        if surface[side] != Vector2::zeros() {
-            r -= c.surface_on_rail * surface[side];
-        }
         let l_inv = l.try_inverse().unwrap_or_else(Matrix2::zeros);
         lhs6 -= x * (l_inv * y);
         rhs6 -= x * (l_inv * r);
         parts[side] = (l_inv, y, r);
     }
     let du = lhs6.lu().solve(&rhs6).unwrap_or(rhs6);
-    for (rail, (l_inv, y, r)) in rails.iter_mut().zip(parts) {
-        let dv = l_inv * (r - y * du);
-        rail.vy += dv.x;
-        rail.vz += dv.y;
-        rail.y += rail.vy * dt;
-        rail.z += rail.vz * dt;
-    }
-    du
+    (du, parts.map(|(l_inv, y, r)| l_inv * (r - y * du)))
 }
 
 #[cfg(test)]

@@ -130,11 +130,43 @@ pub struct TrackSpec {
     pub profile: VerticalProfile,
     /// Irregularities, if any.
     pub irregularity: Option<IrregularitySpec>,
-    /// Compliant rail support under each wheel (None: rigid rails).
+    /// Compliant rail support under each wheel, lumped (`[rail_support]`, model "lumped");
+    /// None with rigid rails or rails on sleepers.
     pub rail_support: Option<super::support::RailSupport>,
+    /// Rails as beams on discrete sleepers (`[rail_support] model = "discrete"`); None
+    /// otherwise. At most one of the two is set ([`TrackSpec::set_rail_model`]).
+    pub discrete_rails: Option<super::discrete::DiscreteSupport>,
 }
 
 impl TrackSpec {
+    /// Chooses the rails' support by name, over the file's (`simulate --rail-support`, the
+    /// plan key `rail_support`): "rigid", "lumped" (the file's lumped masses, which it must
+    /// have) or "discrete" (the file's discrete parameters, else the default set).
+    pub fn set_rail_model(&mut self, model: &str) -> crate::error::Result<()> {
+        match model {
+            "rigid" => (self.rail_support, self.discrete_rails) = (None, None),
+            "lumped" => {
+                if self.rail_support.is_none() {
+                    return Err(crate::error::Error::Domain(format!(
+                        "rail support \"lumped\": track '{}' has no lumped [rail_support] masses to take",
+                        self.name
+                    )));
+                }
+                self.discrete_rails = None;
+            }
+            "discrete" => {
+                self.discrete_rails = Some(self.discrete_rails.unwrap_or_default());
+                self.rail_support = None;
+            }
+            other => {
+                return Err(crate::error::Error::Domain(format!(
+                    "rail support must be \"rigid\", \"lumped\" or \"discrete\", got \"{other}\""
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Whether any section is a curve.
     pub fn has_curves(&self) -> bool {
         self.sections
@@ -310,6 +342,14 @@ impl TrackSpec {
             ));
         }
 
+        let (rail_support, discrete_rails) = match &raw.rail_support {
+            None => (None, None),
+            Some(f) => match f.model(path)? {
+                super::support::RailModel::Lumped(l) => (Some(l), None),
+                super::support::RailModel::Discrete(d) => (None, Some(d)),
+            },
+        };
+
         let profile = match &raw.profile {
             None => VerticalProfile::level(0.0),
             Some(p) => parse_profile(p, path, length)?,
@@ -402,10 +442,8 @@ impl TrackSpec {
             sections,
             profile,
             irregularity,
-            rail_support: match &raw.rail_support {
-                Some(f) => Some(super::support::RailSupport::from_file(f, path)?),
-                None => None,
-            },
+            rail_support,
+            discrete_rails,
         })
     }
 

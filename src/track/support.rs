@@ -51,21 +51,87 @@ pub struct RailSupport {
     pub vertical: Support,
 }
 
-/// `[rail_support]` in a track file.
+/// `[rail_support]` in a track file: `model = "lumped"` (the default: the six keys below) or
+/// `model = "discrete"` (rails on sleepers, [`super::discrete`]; its keys, all optional, in
+/// `[rail_support.discrete]`).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RailSupportFile {
-    lateral_mass_kg: f64,
-    lateral_stiffness_n_per_m: f64,
-    lateral_damping_ns_per_m: f64,
-    vertical_mass_kg: f64,
-    vertical_stiffness_n_per_m: f64,
-    vertical_damping_ns_per_m: f64,
+    model: Option<String>,
+    lateral_mass_kg: Option<f64>,
+    lateral_stiffness_n_per_m: Option<f64>,
+    lateral_damping_ns_per_m: Option<f64>,
+    vertical_mass_kg: Option<f64>,
+    vertical_stiffness_n_per_m: Option<f64>,
+    vertical_damping_ns_per_m: Option<f64>,
+    discrete: Option<super::discrete::DiscreteFile>,
+}
+
+/// The rail support a track file chose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum RailModel {
+    /// Lumped rail masses under each wheel.
+    Lumped(RailSupport),
+    /// Rails on discrete sleepers.
+    Discrete(super::discrete::DiscreteSupport),
+}
+
+impl RailSupportFile {
+    /// The model the table chose, every key checked.
+    pub(super) fn model(&self, path: &Path) -> Result<RailModel> {
+        let lumped_keys = [
+            self.lateral_mass_kg,
+            self.lateral_stiffness_n_per_m,
+            self.lateral_damping_ns_per_m,
+            self.vertical_mass_kg,
+            self.vertical_stiffness_n_per_m,
+            self.vertical_damping_ns_per_m,
+        ];
+        match self.model.as_deref().unwrap_or("lumped") {
+            "lumped" => {
+                if self.discrete.is_some() {
+                    return Err(Error::config(
+                        path,
+                        "rail_support.discrete",
+                        "belongs to model = \"discrete\" (this table's model is \"lumped\")",
+                    ));
+                }
+                RailSupport::from_file(self, path).map(RailModel::Lumped)
+            }
+            "discrete" => {
+                if lumped_keys.iter().any(Option::is_some) {
+                    return Err(Error::config(
+                        path,
+                        "rail_support",
+                        "model = \"discrete\" takes its keys in [rail_support.discrete], not the lumped masses' (lateral_mass_kg, …)",
+                    ));
+                }
+                let d = self.discrete.as_ref();
+                let p = match d {
+                    Some(d) => d.support(path)?,
+                    None => super::discrete::DiscreteFile::default().support(path)?,
+                };
+                Ok(RailModel::Discrete(p))
+            }
+            other => Err(Error::config(
+                path,
+                "rail_support.model",
+                format!("must be \"lumped\" or \"discrete\", got \"{other}\""),
+            )),
+        }
+    }
 }
 
 impl RailSupport {
-    pub(super) fn from_file(f: &RailSupportFile, path: &Path) -> Result<Self> {
-        let check = |field: &str, v: f64, zero_ok: bool| -> Result<f64> {
+    fn from_file(f: &RailSupportFile, path: &Path) -> Result<Self> {
+        let check = |field: &str, v: Option<f64>, zero_ok: bool| -> Result<f64> {
+            let Some(v) = v else {
+                return Err(Error::config(
+                    path,
+                    format!("rail_support.{field}"),
+                    "missing (the lumped model needs all six masses, stiffnesses and dampings)",
+                ));
+            };
             if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) {
                 Ok(v)
             } else {

@@ -127,7 +127,7 @@ impl Beam {
 
     /// Modal coordinates from values at the interior nodes (the inverse DST-I):
     /// `q_k = 2/(N·scale)·Σ_j sin(kπj/N)·w_j`, `sines[k·(N−1) + j]` = `sin((k+1)π(j+1)/N)`.
-    pub(super) fn from_nodes(&self, nodes: &[f64], sines: &[f64], out: &mut [f64]) {
+    pub(super) fn modes_from_nodes(&self, nodes: &[f64], sines: &[f64], out: &mut [f64]) {
         let n = nodes.len();
         let c = 2.0 / ((n + 1) as f64 * self.scale);
         for (k, o) in out.iter_mut().enumerate() {
@@ -136,7 +136,7 @@ impl Beam {
     }
 
     /// Values at the interior nodes from modal coordinates `m` (the DST-I).
-    pub(super) fn to_nodes(&self, m: &[f64], sines: &[f64], out: &mut [f64]) {
+    pub(super) fn nodes_from_modes(&self, m: &[f64], sines: &[f64], out: &mut [f64]) {
         let n = m.len();
         for (j, o) in out.iter_mut().enumerate() {
             *o = self.scale * dot(&sines[j * n..(j + 1) * n], m);

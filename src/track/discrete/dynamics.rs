@@ -148,11 +148,11 @@ impl TrackDynamics {
         for rail in self.rails.iter_mut().flatten() {
             for which in 0..2 {
                 let m = if which == 0 { &rail.q } else { &rail.v };
-                rail.to_nodes(m, &self.sines, &mut self.nodes[0]);
+                rail.nodes_from_modes(m, &self.sines, &mut self.nodes[0]);
                 for j in 0..len {
                     self.nodes[1][j] = moved(j).map_or(0.0, |i| self.nodes[0][i]);
                 }
-                rail.from_nodes(&self.nodes[1], &self.sines, &mut self.modal);
+                rail.modes_from_nodes(&self.nodes[1], &self.sines, &mut self.modal);
                 let m = if which == 0 { &mut rail.q } else { &mut rail.v };
                 m.copy_from_slice(&self.modal);
             }
@@ -187,7 +187,7 @@ impl TrackDynamics {
                 }
                 let rail = &mut self.rails[side][dir];
                 // Modal force Σ_j φ_k(x_j)·f_j: the DST-I of the nodal forces.
-                rail.to_nodes(&self.nodes[0], &self.sines, &mut self.modal);
+                rail.nodes_from_modes(&self.nodes[0], &self.sines, &mut self.modal);
                 rail.begin(dt, &self.modal);
             }
         }
@@ -219,8 +219,8 @@ impl TrackDynamics {
             for (dir, rail) in rails.iter_mut().enumerate() {
                 rail.end(dt);
                 let (w, v) = &mut nodal[side][dir];
-                rail.to_nodes(&rail.q, &self.sines, w);
-                rail.to_nodes(&rail.v, &self.sines, v);
+                rail.nodes_from_modes(&rail.q, &self.sines, w);
+                rail.nodes_from_modes(&rail.v, &self.sines, v);
             }
         }
         let (b, pv, pl, bal) = (
