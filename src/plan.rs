@@ -27,6 +27,9 @@ struct PlanFile {
     turn: Option<String>,
     /// What a run that derails does to the data set: `fail` (the default) or `drop`.
     derailed: Option<String>,
+    /// The rails' support of every condition that names none: `rigid`, `lumped` or
+    /// `discrete` (absent: the track file's).
+    rail_support: Option<String>,
     #[serde(default)]
     condition: Vec<ConditionFile>,
 }
@@ -61,6 +64,7 @@ struct ConditionFile {
     position: Option<f64>,
     turn: Option<String>,
     gauge_face: Option<String>,
+    rail_support: Option<String>,
     vary: Option<toml::Table>,
 }
 
@@ -198,6 +202,9 @@ pub struct Condition {
     /// Friction of the rail's gauge face instead of the vehicle file's (`gauge_face =
     /// "lubricated"`: [`LUBRICATED_GAUGE_FACE`]; `"dry"` or absent: the file's).
     pub flange_friction: Option<f64>,
+    /// The rails' support instead of the track file's (`rail_support = "rigid"`, `"lumped"`
+    /// or `"discrete"`, [`crate::track::TrackSpec::set_rail_model`]; None: the file's).
+    pub rail_support: Option<String>,
 }
 
 impl Condition {
@@ -398,6 +405,20 @@ impl Plan {
                     ));
                 }
             };
+            let rail_support = c.rail_support.clone().or_else(|| raw.rail_support.clone());
+            if let Some(m) = &rail_support
+                && !crate::track::RAIL_SUPPORT_MODELS.contains(&m.as_str())
+            {
+                return Err(Error::config(
+                    path,
+                    if c.rail_support.is_some() {
+                        f("rail_support")
+                    } else {
+                        "rail_support".into()
+                    },
+                    format!("{m:?}: give one of {:?}", crate::track::RAIL_SUPPORT_MODELS),
+                ));
+            }
             let train = match &consist {
                 Some(name) => crate::sim::hitch::TrainSetup::resolve(
                     name,
@@ -423,6 +444,7 @@ impl Plan {
                 turns,
                 order: conditions.len(),
                 flange_friction,
+                rail_support,
             });
         }
         // Every file the plan names must be there now, not when its run comes up (checked last,

@@ -44,6 +44,8 @@ mod mutation;
 mod mutation_commands;
 #[path = "neural.rs"]
 mod neural;
+#[path = "rails_on_sleepers.rs"]
+mod rails_on_sleepers;
 #[path = "sensitivity.rs"]
 mod sensitivity;
 #[path = "sensors.rs"]

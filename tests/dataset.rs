@@ -117,6 +117,7 @@ fn generate_resume_shard_merge_and_formats() {
     let stepping = railforce::sim::Stepping {
         integrator: railforce::sim::Integrator::SemiImplicit,
         dt: 2e-4,
+        given: true,
     };
     std::fs::create_dir_all(&li).unwrap();
     for f in ["manifest.json", "tangent_v80_seed1.npz"] {

@@ -26,6 +26,12 @@ pub struct SimulateArgs {
     /// Irregularity seed (overrides the track file's).
     #[arg(long)]
     seed: Option<u64>,
+    /// The rails' support, over the track file's `[rail_support]`: `rigid`; `lumped` (a rail
+    /// mass on springs under each wheel: the file's); `discrete` (rails as beams on sleepers,
+    /// ballast and subgrade, Zhai's parameters unless the file gives its own; about 2.4 times
+    /// the step's cost, the default integrator only).
+    #[arg(long, value_parser = railforce::track::RAIL_SUPPORT_MODELS)]
+    rail_support: Option<String>,
     /// Output file, its format by its extension: `.csv`, `.parquet` (what `generate` writes) or
     /// `.npz`; a `.meta.json` file is written beside it.
     #[arg(long, default_value = "run.csv")]
@@ -87,8 +93,14 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     args.vehicle = super::builtin::resolve(&args.vehicle)?;
     args.track = super::builtin::resolve(&args.track)?;
     let vehicle = Vehicle::load(&args.vehicle)?;
-    let track = Track::new(TrackSpec::load(&args.track)?, args.seed);
+    let mut spec = TrackSpec::load(&args.track)?;
+    if let Some(m) = &args.rail_support {
+        spec.set_rail_model(m)?;
+    }
+    let track = Track::new(spec, args.seed);
     let mut cfg = cfg;
+    cfg.dt = request.stepping.step_on(track.spec());
+    let dt = cfg.dt;
     cfg.train = railforce::sim::hitch::TrainSetup::resolve(
         &args.consist,
         args.position,
@@ -111,12 +123,12 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         "train": train_meta,
         "tool": format!("railforce {}", env!("CARGO_PKG_VERSION")),
         "vehicle": {"file": args.vehicle, "hash_fnv1a": railforce::dataset::file_hash(&args.vehicle)?, "name": vehicle.name},
-        "track": {"file": args.track, "hash_fnv1a": railforce::dataset::file_hash(&args.track)?, "name": track.spec().name},
+        "track": {"file": args.track, "hash_fnv1a": railforce::dataset::file_hash(&args.track)?, "name": track.spec().name, "rail_support": track.spec().rail_model()},
         "seed": track.irregularities().map(|i| i.spec().seed),
         "speed_kmh": args.speed_kmh,
         "duration_s": args.duration,
         "settle_s": args.settle,
-        "integration_step_s": request.stepping.dt,
+        "integration_step_s": dt,
         "integrator": request.stepping.integrator.name(),
         "sampling_rate_hz": sim.config().output_rate,
         "anti_alias": format!("8th-order Butterworth low-pass at {} Hz at the integration rate, then decimation", sim.config().cutoff),
@@ -159,7 +171,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         args.settle,
         summary.wall,
         summary.real_time_factor,
-        request.stepping.dt * 1e3,
+        dt * 1e3,
         command_start.elapsed().as_secs_f64()
     );
     print!("peak |Y/Q|:");

@@ -368,6 +368,9 @@ pub(super) fn run_key(
     if let Some(mu) = run.condition.flange_friction {
         extra += &format!("|gauge_face={mu}");
     }
+    if let Some(m) = &run.condition.rail_support {
+        extra += &format!("|rail_support={m}");
+    }
     if !draws.is_empty() {
         extra += &format!(
             "|vary={}",

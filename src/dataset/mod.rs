@@ -280,6 +280,15 @@ pub fn generate(
         if mirrored {
             spec.mirror();
         }
+        if let Some(m) = &r.condition.rail_support {
+            spec.set_rail_model(m).map_err(|e| {
+                Error::config(
+                    &plan.source,
+                    format!("condition {}.rail_support", r.condition.name),
+                    e.to_string(),
+                )
+            })?;
+        }
         tracks.push(Prepared {
             spec,
             mirrored,
@@ -412,7 +421,7 @@ pub fn generate(
             // One set of channels in a data set: every run records the couplers when any
             // condition runs in a train.
             coupler_channels: plan.conditions.iter().any(|c| c.train.is_some()),
-            dt: opts.stepping.dt,
+            dt: opts.stepping.step_on(spec),
             integrator: opts.stepping.integrator,
             // A derailment risk (Nadal's limit held 50 ms) is reported and the run kept: a
             // data set wants those forces; a flange climb still stops the run.

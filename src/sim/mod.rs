@@ -31,7 +31,7 @@ mod watch;
 mod wheel_rail;
 mod wheelset_solve;
 
-pub use integrator::{Integrator, Stepping};
+pub use integrator::{Integrator, MAX_STEP_ON_BEAMS, Stepping};
 pub use output::{Recorder, RunSummary};
 pub use request::RunRequest;
 pub use track_frame::{TrackFrame, project};
@@ -266,16 +266,20 @@ impl<'a> Simulation<'a> {
         let centred = table.lookup(0.0);
         // The rails sink under the static load on a compliant track; the wheelsets sit at the
         // height where each wheel carries its share (the run's own contact evaluation).
-        // On sleepers the track settles under the static loads first (the integrators that
-        // take the rails' step mobility into the wheelsets' solve only).
+        // On sleepers the track settles under the static loads first (the integrator that
+        // takes the Hertz spring into the wheelsets' solve only).
         let beams = match track.spec().discrete_rails {
             None => None,
             Some(p) => {
-                if cfg.integrator.shares(cfg.dt).is_none() {
+                if cfg
+                    .integrator
+                    .shares(cfg.dt)
+                    .is_none_or(|s| s.alpha_dt == 0.0)
+                {
                     return Err(Error::Domain(format!(
-                        "track '{}' has rails on discrete sleepers: they run with the linearly implicit integrators (linearly-implicit-hertz, the default, or linearly-implicit), not {:?}",
+                        "track '{}' has rails on discrete sleepers: they run with the integrator that takes the Hertz spring into the wheelsets' solve (linearly-implicit-hertz, the default), not {} (the rail's modal mass under a wheel is tens of kg: an explicit Hertz spring on it bursts)",
                         track.spec().name,
-                        cfg.integrator
+                        cfg.integrator.name()
                     )));
                 }
                 let ws: Vec<f64> = (vehicle.contact.wheelsets.iter())

@@ -138,6 +138,9 @@ pub struct TrackSpec {
     pub discrete_rails: Option<super::discrete::DiscreteSupport>,
 }
 
+/// The rails' supports a run can choose by name ([`TrackSpec::set_rail_model`]).
+pub const RAIL_SUPPORT_MODELS: [&str; 3] = ["rigid", "lumped", "discrete"];
+
 impl TrackSpec {
     /// Chooses the rails' support by name, over the file's (`simulate --rail-support`, the
     /// plan key `rail_support`): "rigid", "lumped" (the file's lumped masses, which it must
@@ -165,6 +168,15 @@ impl TrackSpec {
             }
         }
         Ok(())
+    }
+
+    /// The rails' support by name: "rigid", "lumped" or "discrete".
+    pub fn rail_model(&self) -> &'static str {
+        match (self.rail_support, self.discrete_rails) {
+            (_, Some(_)) => "discrete",
+            (Some(_), None) => "lumped",
+            (None, None) => "rigid",
+        }
     }
 
     /// Whether any section is a curve.

@@ -13,7 +13,7 @@ mod profile;
 mod support;
 
 pub use alignment::{Alignment, Section, SectionKind, Turn, cant_deficiency_acceleration};
-pub use file::{MAX_CANT_MM, MAX_GRADIENT_PERMILLE, TrackSpec};
+pub use file::{MAX_CANT_MM, MAX_GRADIENT_PERMILLE, RAIL_SUPPORT_MODELS, TrackSpec};
 pub use irregularity::{
     Channel, FraClass, GermanSpectrum, Irregularities, IrregularitySpec, RailIrregularity, Spectrum,
 };

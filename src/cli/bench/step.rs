@@ -33,8 +33,13 @@ pub struct StepArgs {
     steps: Vec<f64>,
     /// Take the rails as rigid (drop the track file's `[rail_support]`): separates the
     /// rail masses' part in the step limit from the vehicle's.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "rail_support")]
     rigid_rails: bool,
+    /// The rails' support over the track file's (`rigid`, `lumped`, `discrete`; as
+    /// `simulate --rail-support`). On rails on sleepers the reference must be
+    /// `--reference-integrator linearly-implicit-hertz` (the only integrator they run with).
+    #[arg(long, value_parser = railforce::track::RAIL_SUPPORT_MODELS)]
+    rail_support: Option<String>,
     /// Integrator of the compared steps (default: the default integrator, linearly implicit
     /// with the contact's Hertz spring).
     #[arg(long, value_parser = Integrator::NAMES)]
@@ -57,11 +62,16 @@ pub fn run(args: &StepArgs) -> Result<()> {
     }
     let v = railforce::vehicle::Vehicle::load(&super::super::builtin::resolve(vehicle)?)?;
     let mut spec = TrackSpec::load(&super::super::builtin::resolve(track)?)?;
-    let rails = if rigid_rails || spec.rail_support.is_none() {
-        spec.rail_support = None;
-        "rigid rails"
-    } else {
-        "compliant rails"
+    if rigid_rails {
+        spec.set_rail_model("rigid")?;
+    }
+    if let Some(m) = &args.rail_support {
+        spec.set_rail_model(m)?;
+    }
+    let rails = match spec.rail_model() {
+        "rigid" => "rigid rails",
+        "lumped" => "compliant rails, lumped",
+        _ => "rails on discrete sleepers",
     };
     let tr = Track::new(spec, None);
     let s = step_study(

@@ -87,11 +87,12 @@ impl Beam {
     /// dampers and the modal forces `f` (N/√kg, the pads' sleeper side and any load held
     /// over the step).
     pub fn begin(&mut self, dt: f64, f: &[f64]) {
-        for k in 0..self.q.len() {
-            let (kk, ck) = (self.stiffness[k], self.damping[k]);
-            self.lhs[k] = 1.0 + dt * ck + dt * dt * kk;
-            self.dv[k] =
-                dt * (f[k] - kk * (self.q[k] + dt * self.v[k]) - ck * self.v[k]) / self.lhs[k];
+        let state = self.q.iter().zip(&self.v).zip(f);
+        let coefficients = self.stiffness.iter().zip(&self.damping);
+        let out = self.lhs.iter_mut().zip(&mut self.dv);
+        for (((q, v), f), ((kk, ck), (l, dv))) in state.zip(coefficients.zip(out)) {
+            *l = 1.0 + dt * ck + dt * dt * kk;
+            *dv = dt * (f - kk * (q + dt * v) - ck * v) / *l;
         }
     }
 
