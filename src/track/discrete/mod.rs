@@ -29,10 +29,12 @@
 mod beam;
 mod dynamics;
 mod file;
+mod receptance;
 
 pub use beam::Beam;
 pub use dynamics::{Load, TrackDynamics};
 pub(super) use file::DiscreteFile;
+pub use receptance::{cut_on_frequencies, receptance};
 
 /// A spring and a damper in parallel.
 #[derive(Debug, Clone, Copy, PartialEq)]
