@@ -160,11 +160,11 @@ pub struct Stepping {
 }
 
 /// The longest step a run on rails on sleepers takes ([`crate::track::discrete`]) unless
-/// told otherwise. At 5/6 ms the lateral rail under a flanging wheel (a bay's rail mass, 36 kg,
-/// against the flange's Hertz stiffness) is not followed: on R 400 m at 100 km/h, Q's standard
-/// deviation 20 % and FL's 12 % off the same model at 0.1 ms; at 0.5 ms 0.35 % and 0.81 %
-/// (`railforce bench step --rail-support discrete --reference 1e-4 --reference-integrator
-/// linearly-implicit-hertz`).
+/// told otherwise. At 5/6 ms the rail under a flanging wheel (a bay's rail mass, 36 kg, against
+/// the flange's Hertz stiffness) is not followed: on R 400 m at 100 km/h, Q's standard
+/// deviation 90 % off the same model at 0.1 ms; at 0.5 ms 0.27 %, FL's 0.89 %, Y/Q rms 1.7 %
+/// (physics.md §3.3; `railforce bench step --rail-support discrete --reference 1e-4
+/// --reference-integrator linearly-implicit-hertz`).
 pub const MAX_STEP_ON_BEAMS: f64 = 5e-4;
 
 impl PartialEq for Stepping {

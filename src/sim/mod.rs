@@ -285,6 +285,24 @@ impl<'a> Simulation<'a> {
                 let ws: Vec<f64> = (vehicle.contact.wheelsets.iter())
                     .map(|&w| start + vehicle.bodies[w].position.x)
                     .collect();
+                // Each end of the window at least 6/β beyond the outer wheels (the basin down
+                // to e^(−6), 0.25 %), with half a bay for the window's shifts.
+                let span = ws.iter().fold(f64::MIN, |a, &b| a.max(b))
+                    - ws.iter().fold(f64::MAX, |a, &b| a.min(b));
+                let needed = span + 12.0 / p.beta() + p.spacing;
+                if p.window() < needed {
+                    return Err(Error::Domain(format!(
+                        "track '{}': rail_support.discrete.window_bays = {} ({:.1} m) is too short for vehicle '{}' (wheels over {:.1} m): the window needs {:.1} m ({} bays of {} m)",
+                        track.spec().name,
+                        p.bays,
+                        p.window(),
+                        vehicle.name,
+                        span,
+                        needed,
+                        (needed / p.spacing).ceil(),
+                        p.spacing
+                    )));
+                }
                 Some(rail_beams::settled(p, &ws, static_load, cfg.dt))
             }
         };

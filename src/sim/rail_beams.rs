@@ -2,8 +2,8 @@
 //! follows the wagon, each wheel reads the rail under it at its own position, and each
 //! wheelset's linearly implicit solve takes the rail's step mobility under its wheels.
 //!
-//! In a wheelset's solve a rail point behaves as a body of mass `1/W` (W the beam's step
-//! mobility at the wheel, [`crate::track::discrete::Beam::free`]) already moving by the
+//! In a wheelset's solve a rail point behaves as a body of mass `1/W` (W the track's step
+//! mobility at the wheel, [`crate::track::discrete::TrackDynamics::free`]) already moving by the
 //! beam's free change `Δv_free`: its rows are `(1/W + θΔt·C_c)·Δr = Δv_free/W + Δt·F − …`, the
 //! lumped rail's rows with the beam in place of the mass on its spring. The wheelsets solve
 //! one after another. The step starts with every wheel's impulse of the step before on the

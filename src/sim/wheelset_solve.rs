@@ -136,11 +136,11 @@ pub(super) const THETA: f64 = 0.5;
 pub(super) const ALPHA: f64 = 0.15;
 
 /// The Hertz spring's share `α` when the rails are beams on sleepers
-/// ([`crate::track::discrete`]). Under a wheel the beam's inertia over a step is its modes'
-/// mass alone, about 37 kg at the default step (the rest of its step mass, 263 kg, is the
-/// modes' stiffness taken implicitly), so the wheel–rail mode runs at ω·Δt ≈ 5.7, beyond
-/// α = 0.15's limit of 3.16: with it, R 400 m at 60 km/h burst within a second of settling
-/// at any step from 0.8 ms, and held at 0.75 ms. α = ¼ is the average acceleration's,
+/// ([`crate::track::discrete`]). Under a wheel the rail's inertia over a step is its modes'
+/// mass alone, about a bay of rail (36 kg; the rest of its step mass is the modes' stiffness
+/// taken implicitly), so the wheel–rail mode runs at ω·Δt ≈ 5.7 at 5/6 ms, beyond α = 0.15's
+/// limit of 3.16: with it, R 400 m at 60 km/h burst within a second of settling at any step
+/// from 0.8 ms, and held at 0.75 ms. α = ¼ is the average acceleration's,
 /// stable at any step for a linear spring; it puts that mode (P1, above 1 kHz on such a
 /// track) near 360 Hz at the default step, far above the recorded 100 Hz band (an estimate
 /// from `ω̃² = ω²/(1 + α·ω²·Δt²)`). A wagon on beams needs a step near 0.1 ms to follow P1.

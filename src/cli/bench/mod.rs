@@ -73,9 +73,14 @@ enum What {
         /// Integrator (default: the default; `bench step` measures what each costs in accuracy).
         #[arg(long, value_parser = railforce::sim::Integrator::NAMES)]
         integrator: Option<String>,
-        /// Integration step, s (default: the integrator's own).
+        /// Integration step, s (default: the integrator's own; 0.5 ms on rails on sleepers).
         #[arg(long)]
         dt: Option<f64>,
+        /// The rails' support over the track file's (`rigid`, `lumped`, `discrete`, as
+        /// `simulate --rail-support`); when it changes the file's, the file's own is timed in
+        /// the same run and the ratio printed (what the track costs).
+        #[arg(long, value_parser = railforce::track::RAIL_SUPPORT_MODELS, conflicts_with = "against")]
+        rail_support: Option<String>,
         /// Another railforce binary (an older build, say) to time against this one: `--repeat`
         /// rounds, each measuring both, in alternating order; prints each round's real-time
         /// factors and the ratio of the medians (this build's speed-up). Each binary steps at
@@ -179,6 +184,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             repeat,
             integrator,
             dt,
+            rail_support,
             against,
         } => {
             if cfg!(debug_assertions) {
@@ -192,12 +198,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
             let t0 = std::time::Instant::now();
             v.contact.table();
             let table_s = t0.elapsed().as_secs_f64();
-            let tr = railforce::track::Track::load(&track)?;
+            let file_track = railforce::track::Track::load(&track)?;
+            let mut spec = file_track.spec().clone();
+            if let Some(m) = &rail_support {
+                spec.set_rail_model(m)?;
+            }
+            let tr = railforce::track::Track::new(spec, None);
             let default = railforce::sim::SimConfig::default();
             let stepping = railforce::sim::Stepping::chosen(integrator.as_deref(), dt);
             let base = railforce::sim::SimConfig {
                 integrator: stepping.integrator,
-                dt: stepping.dt,
+                dt: stepping.step_on(tr.spec()),
                 ..default.clone()
             };
             if let Some(other) = against {
@@ -222,13 +233,30 @@ pub fn run(args: BenchArgs) -> Result<()> {
             let repeat = repeat as usize;
             let b = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, repeat, &base)?;
             println!(
-                "simulation benchmark: {} on {}, {speed_kmh} km/h, {seconds} s, {} step {} ms, one thread, fastest of {repeat}",
+                "simulation benchmark: {} on {} ({} rails), {speed_kmh} km/h, {seconds} s, {} step {} ms, one thread, fastest of {repeat}",
                 v.name,
                 tr.spec().name,
+                tr.spec().rail_model(),
                 base.integrator.name(),
                 b.dt * 1e3
             );
-            if base.integrator != default.integrator || base.dt != default.dt {
+            let own = file_track.spec().rail_model();
+            if tr.spec().rail_model() != own {
+                let file_cfg = railforce::sim::SimConfig {
+                    dt: stepping.step_on(file_track.spec()),
+                    ..base.clone()
+                };
+                let r =
+                    simulate::run(&v, &file_track, speed_kmh / 3.6, seconds, repeat, &file_cfg)?;
+                println!(
+                    "  against the file's {own} rails ({} ms) in the same run: physics {:.2}× ({:.1}× real time), all channels {:.2}× ({:.1}× real time)",
+                    file_cfg.dt * 1e3,
+                    b.real_time_factor / r.real_time_factor,
+                    r.real_time_factor,
+                    b.real_time_factor_recorded / r.real_time_factor_recorded,
+                    r.real_time_factor_recorded
+                );
+            } else if base.integrator != default.integrator || base.dt != default.dt {
                 let r = simulate::run(&v, &tr, speed_kmh / 3.6, seconds, repeat, &default)?;
                 println!(
                     "  against the default ({} at {} ms) in the same run: physics {:.2}× ({:.1}× real time), all channels {:.2}× ({:.1}× real time)",

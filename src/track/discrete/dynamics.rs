@@ -1,45 +1,34 @@
-//! The discrete track's state and step: two rails (lateral and vertical beams), a sleeper at
-//! every interior fastener (vertical, lateral, roll) and a ballast block under each rail seat,
-//! in a window that shifts by whole bays to stay centred on the vehicle.
+//! The discrete track's state and step, one wavenumber at a time.
 //!
-//! A step: [`TrackDynamics::begin`] (each rail mode's change under its own springs and the
-//! sleepers' side of the pads, taken at the step's start), then the wheels' impulses
-//! ([`TrackDynamics::free`] tells a wheel's solve how the rail under it moves and yields;
-//! [`TrackDynamics::impulse`] applies what it settled on), then [`TrackDynamics::end`]: the
-//! rails move, then the sleepers on the rails' new state, then the ballast blocks on the
-//! sleepers' (each body linearly implicit in its own springs and dampers, its neighbours
-//! taken as they stand).
+//! With identical sleepers at every interior fastener of the window, ballast shear between
+//! neighbours and everything at rest beyond the window's ends, every field of the track (each
+//! rail's vertical and lateral deflection at the fasteners, the sleepers' motion, the ballast
+//! blocks') is a sum of the same sines `sin(kπj/N)`, k = 1 … N−1, and the sines do not mix:
+//! the track falls apart into N−1 independent small systems, one per wavenumber, of six
+//! vertical degrees of freedom (the two rails' amplitudes, the sleepers' bounce and roll, the
+//! two ballast blocks') and three lateral (the two rails, the sleepers' sway). A rail's modal
+//! coordinate `q_k` of `φ_k = √(2/mL)·sin(kπx/L)` is its amplitude at the fasteners divided
+//! by `√(2/mL)`, so the rail's amplitude behaves as a mass `m·s` per fastener with the bending
+//! stiffness `s·EI·(kπ/L)⁴` of its mode; the ballast's shear adds `2·k_w·(1 − cos(kπ/N))` to
+//! each block. A wheel's force `P` at `x` enters each amplitude as `(2/N)·sin(kπx/L)·P` and
+//! the rail's deflection there is `Σ_k a_k·sin(kπx/L)`.
+//!
+//! Each system steps as the vehicle's wheelsets do, symplectic Euler with its springs and
+//! dampers shared into the step's end: `(M + Δt/2·C + Δt²/4·K)·Δv = Δt·(F − K·x − C·v)`,
+//! `Δx = Δt·(v + Δv)` (the shares of the wheel's Hertz spring, §6 of physics.md, at α = ¼:
+//! stable at any step, a linear spring's frequency lowered to `ω/√(1 + ω²Δt²/4)`, no numerical
+//! damping), its inverse built once per step length. Backward Euler (`Δt²·K` and `Δt·C`
+//! whole) damped the 50–250 Hz track modes by ζ ≈ ω·Δt/2, 4 % off in Y/Q rms at 0.5 ms on
+//! R 400 m at 100 km/h; the trapezoidal rule's displacement `Δt·(v + Δv/2)` is not the one the
+//! wheel's solve takes for the rail, and burst. The nodal fields are needed only when the window shifts by whole bays
+//! (every 0.6 m of travel): the sines' transform and its inverse, exact.
 
-use super::{Beam, DiscreteSupport};
+use super::DiscreteSupport;
+use nalgebra::{Matrix3, Matrix6, SVector, Vector3, Vector6};
 
-/// Left and right rail (track y positive to the left).
+/// Left and right rail (track y positive to the left): the sign of a rail seat's lever
+/// about the sleeper's centre.
 const SIDES: [f64; 2] = [1.0, -1.0];
-
-/// One degree of freedom: displacement and velocity.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct Dof {
-    x: f64,
-    v: f64,
-}
-
-impl Dof {
-    /// Moves under the force `f` (N, all forces at the current state) with its own stiffness
-    /// `k` and damping `c` taken at the step's end, mass `m`, step `dt`.
-    #[inline]
-    fn step(&mut self, f: f64, m: f64, k: f64, c: f64, dt: f64) {
-        let dv = dt * (f - k * dt * self.v) / (m + dt * c + dt * dt * k);
-        self.v += dv;
-        self.x += dt * self.v;
-    }
-}
-
-/// A sleeper: vertical (m, up), roll (rad, left seat up) and lateral (m, left).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct Sleeper {
-    z: Dof,
-    roll: Dof,
-    y: Dof,
-}
 
 /// A force on a rail, held over a step (N; lateral positive to the left, vertical up).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,23 +43,72 @@ pub struct Load {
     pub vertical: f64,
 }
 
+/// One wavenumber's mass, stiffness and damping (`D` degrees of freedom).
+#[derive(Debug, Clone, Copy)]
+struct System<const D: usize> {
+    /// The rails' bending (diagonal), taken whole at the step's end.
+    bend: SVector<f64, D>,
+    k: nalgebra::SMatrix<f64, D, D>,
+    c: nalgebra::SMatrix<f64, D, D>,
+    /// `(M + Δt/2·C + Δt²/4·K)⁻¹` at the current step.
+    inv: nalgebra::SMatrix<f64, D, D>,
+    m: SVector<f64, D>,
+}
+
+impl<const D: usize> System<D> {
+    /// Adds a spring `k` and damper `c` whose elongation is `e·x`.
+    fn spring(&mut self, e: SVector<f64, D>, k: f64, c: f64) {
+        self.k += e * e.transpose() * k;
+        self.c += e * e.transpose() * c;
+    }
+
+    fn factor(&mut self, dt: f64) {
+        let a = nalgebra::SMatrix::<f64, D, D>::from_diagonal(&self.m)
+            + self.c * (0.5 * dt)
+            + self.k * (dt * dt / 12.0)
+            + nalgebra::SMatrix::<f64, D, D>::from_diagonal(&self.bend) * (dt * dt);
+        self.inv = a.try_inverse().unwrap_or_else(nalgebra::SMatrix::zeros);
+    }
+}
+
+/// One wavenumber's state: displacement, velocity and the step's velocity change so far.
+#[derive(Debug, Clone, Copy)]
+struct State<const D: usize> {
+    x: SVector<f64, D>,
+    v: SVector<f64, D>,
+    dv: SVector<f64, D>,
+}
+
+impl<const D: usize> Default for State<D> {
+    fn default() -> Self {
+        State {
+            x: SVector::zeros(),
+            v: SVector::zeros(),
+            dv: SVector::zeros(),
+        }
+    }
+}
+
+/// Vertical degrees of freedom: rails (left, right), sleeper bounce and roll, ballast (left,
+/// right). Lateral: rails (left, right), sleeper sway.
+const RAIL: [usize; 2] = [0, 1];
+
 /// The discrete track in its window.
 #[derive(Debug, Clone)]
 pub struct TrackDynamics {
     p: DiscreteSupport,
     /// Along-track position of the window's start (a sleeper position), m.
     start: f64,
-    /// `[side][0 lateral, 1 vertical]`.
-    rails: [[Beam; 2]; 2],
-    sleepers: Vec<Sleeper>,
-    /// Ballast blocks under the left and right seats.
-    ballast: Vec<[Dof; 2]>,
-    /// `sin((k+1)π(j+1)/N)`, (N−1)² (symmetric).
+    vertical: Vec<System<6>>,
+    lateral: Vec<System<3>>,
+    /// The step the inverses were built for, s.
+    dt: f64,
+    v_state: Vec<State<6>>,
+    l_state: Vec<State<3>>,
+    /// `sin(kπx/L)` at the last position asked for, k = 1 … N−1.
     sines: Vec<f64>,
-    phi: Vec<f64>,
-    /// Scratch: nodal values, modal forces.
-    nodes: [Vec<f64>; 2],
-    modal: Vec<f64>,
+    /// `sin(kπj/N)`, (N−1)², for the window's shifts.
+    table: Vec<f64>,
 }
 
 impl TrackDynamics {
@@ -78,31 +116,76 @@ impl TrackDynamics {
     /// whole multiples of the spacing).
     pub fn new(p: DiscreteSupport, centre: f64) -> Self {
         let n = p.bays - 1;
-        let beam = |ei: f64, pad: super::KelvinVoigt| {
-            Beam::new(
-                p.bays,
-                p.spacing,
-                p.rail_mass,
-                ei,
-                pad.stiffness,
-                pad.damping,
-            )
-        };
-        let lat = beam(p.rail_ei_lateral, p.pad_lateral);
-        let ver = beam(p.rail_ei_vertical, p.pad_vertical);
         let nb = p.bays as f64;
-        let sines = (0..n * n)
+        let (b, ms) = (p.seat_half_distance, p.rail_mass * p.spacing);
+        let mut vertical = Vec::with_capacity(n);
+        let mut lateral = Vec::with_capacity(n);
+        for k in 1..=n {
+            let kappa4 = (k as f64 * std::f64::consts::PI / p.window()).powi(4);
+            let shear = 2.0 * (1.0 - (k as f64 * std::f64::consts::PI / nb).cos());
+            let mut v = System::<6> {
+                bend: Vector6::zeros(),
+                k: Matrix6::zeros(),
+                c: Matrix6::zeros(),
+                inv: Matrix6::zeros(),
+                m: Vector6::new(
+                    ms,
+                    ms,
+                    p.sleeper_mass,
+                    p.sleeper_roll_inertia,
+                    p.ballast_mass,
+                    p.ballast_mass,
+                ),
+            };
+            for (side, sign) in SIDES.iter().enumerate() {
+                let unit = |i: usize| Vector6::from_fn(|r, _| if r == i { 1.0 } else { 0.0 });
+                let seat = unit(2) + unit(3) * (sign * b);
+                v.bend[side] = p.spacing * p.rail_ei_vertical * kappa4;
+                let (pad, bal) = (p.pad_vertical, p.ballast);
+                v.spring(unit(side) - seat, pad.stiffness, pad.damping);
+                v.spring(seat - unit(4 + side), bal.stiffness, bal.damping);
+                let (sg, sh) = (p.subgrade, p.ballast_shear);
+                v.spring(unit(4 + side), sg.stiffness, sg.damping);
+                v.spring(unit(4 + side), shear * sh.stiffness, shear * sh.damping);
+            }
+            for side in 0..2 {
+                v.bend[side] += v.k[(side, side)];
+                v.k[(side, side)] = 0.0;
+            }
+            vertical.push(v);
+            let mut l = System::<3> {
+                bend: Vector3::zeros(),
+                k: Matrix3::zeros(),
+                c: Matrix3::zeros(),
+                inv: Matrix3::zeros(),
+                m: Vector3::new(ms, ms, p.sleeper_mass),
+            };
+            for side in 0..2 {
+                let rail = Vector3::from_fn(|r, _| if r == side { 1.0 } else { 0.0 });
+                l.bend[side] = p.spacing * p.rail_ei_lateral * kappa4;
+                let pad = p.pad_lateral;
+                l.spring(rail - Vector3::z(), pad.stiffness, pad.damping);
+            }
+            let sl = p.sleeper_lateral;
+            l.spring(Vector3::z(), sl.stiffness, sl.damping);
+            for side in 0..2 {
+                l.bend[side] += l.k[(side, side)];
+                l.k[(side, side)] = 0.0;
+            }
+            lateral.push(l);
+        }
+        let table = (0..n * n)
             .map(|i| ((i / n + 1) as f64 * ((i % n) + 1) as f64 * std::f64::consts::PI / nb).sin())
             .collect();
         TrackDynamics {
             start: ((centre - 0.5 * p.window()) / p.spacing).round() * p.spacing,
-            rails: [[lat.clone(), ver.clone()], [lat, ver]],
-            sleepers: vec![Sleeper::default(); n],
-            ballast: vec![[Dof::default(); 2]; n],
-            sines,
-            phi: vec![0.0; n],
-            nodes: [vec![0.0; n], vec![0.0; n]],
-            modal: vec![0.0; n],
+            vertical,
+            lateral,
+            dt: 0.0,
+            v_state: vec![State::default(); n],
+            l_state: vec![State::default(); n],
+            sines: vec![0.0; n],
+            table,
             p,
         }
     }
@@ -117,22 +200,37 @@ impl TrackDynamics {
         self.start
     }
 
-    /// Where `s` lies in the window, m from its start (held inside the window's interior).
-    fn local(&self, s: f64) -> f64 {
+    /// `sin(kπx/L)` for every wavenumber at `s` (held inside the window) into `self.sines`,
+    /// by the Chebyshev recurrence.
+    fn sines_at(&mut self, s: f64) {
         let l = self.p.window();
-        (s - self.start).clamp(1e-6 * l, (1.0 - 1e-6) * l)
+        let x = (s - self.start).clamp(1e-6 * l, (1.0 - 1e-6) * l);
+        let a = std::f64::consts::PI * x / l;
+        let (c2, mut prev, mut cur) = (2.0 * a.cos(), 0.0, a.sin());
+        for p in self.sines.iter_mut() {
+            *p = cur;
+            let next = c2 * cur - prev;
+            prev = cur;
+            cur = next;
+        }
     }
 
     /// The rail `side`'s lateral and vertical displacement and velocity at `s`: `[y, vy, z,
     /// vz]` (m, m/s; y to the left, z up).
     pub fn rail(&mut self, side: usize, s: f64) -> [f64; 4] {
-        let x = self.local(s);
-        let (y, vy) = self.rails[side][0].point(x, &mut self.phi);
-        let (z, vz) = self.rails[side][1].point(x, &mut self.phi);
-        [y, vy, z, vz]
+        self.sines_at(s);
+        let mut r = [0.0; 4];
+        for ((sn, l), v) in self.sines.iter().zip(&self.l_state).zip(&self.v_state) {
+            r[0] += sn * l.x[RAIL[side]];
+            r[1] += sn * l.v[RAIL[side]];
+            r[2] += sn * v.x[RAIL[side]];
+            r[3] += sn * v.v[RAIL[side]];
+        }
+        r
     }
 
-    /// Shifts the window by whole bays so that its centre is within half a bay of `centre`.
+    /// Shifts the window by whole bays so that its centre is within half a bay of `centre`:
+    /// every field to the fasteners, moved, and back (the track entering the window at rest).
     pub fn recentre(&mut self, centre: f64) {
         let n = ((centre - (self.start + 0.5 * self.p.window())) / self.p.spacing).round();
         if n == 0.0 {
@@ -140,144 +238,106 @@ impl TrackDynamics {
         }
         self.start += n * self.p.spacing;
         let shift = n as i64;
-        let len = self.sleepers.len();
-        let moved = |j: usize| -> Option<usize> {
-            let i = j as i64 + shift;
-            (0..len as i64).contains(&i).then_some(i as usize)
+        let (len, g) = (self.v_state.len(), 2.0 / self.p.bays as f64);
+        let table = &self.table;
+        // One field's amplitudes to the fasteners, shifted, and back.
+        let moved = |amps: Vec<f64>| -> Vec<f64> {
+            let nodes: Vec<f64> = (0..len)
+                .map(|j| dot(&table[j * len..(j + 1) * len], &amps))
+                .collect();
+            let shifted: Vec<f64> = (0..len as i64)
+                .map(|j| {
+                    let i = j + shift;
+                    if (0..len as i64).contains(&i) {
+                        nodes[i as usize]
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            (0..len)
+                .map(|k| g * dot(&table[k * len..(k + 1) * len], &shifted))
+                .collect()
         };
-        for rail in self.rails.iter_mut().flatten() {
-            for which in 0..2 {
-                let m = if which == 0 { &rail.q } else { &rail.v };
-                rail.nodes_from_modes(m, &self.sines, &mut self.nodes[0]);
-                for j in 0..len {
-                    self.nodes[1][j] = moved(j).map_or(0.0, |i| self.nodes[0][i]);
-                }
-                rail.modes_from_nodes(&self.nodes[1], &self.sines, &mut self.modal);
-                let m = if which == 0 { &mut rail.q } else { &mut rail.v };
-                m.copy_from_slice(&self.modal);
+        for d in 0..6 {
+            let x = moved(self.v_state.iter().map(|st| st.x[d]).collect());
+            let v = moved(self.v_state.iter().map(|st| st.v[d]).collect());
+            for ((st, x), v) in self.v_state.iter_mut().zip(x).zip(v) {
+                (st.x[d], st.v[d]) = (x, v);
             }
         }
-        let sleepers = (0..len)
-            .map(|j| moved(j).map_or(Sleeper::default(), |i| self.sleepers[i]))
-            .collect();
-        let ballast = (0..len)
-            .map(|j| moved(j).map_or([Dof::default(); 2], |i| self.ballast[i]))
-            .collect();
-        self.sleepers = sleepers;
-        self.ballast = ballast;
+        for d in 0..3 {
+            let x = moved(self.l_state.iter().map(|st| st.x[d]).collect());
+            let v = moved(self.l_state.iter().map(|st| st.v[d]).collect());
+            for ((st, x), v) in self.l_state.iter_mut().zip(x).zip(v) {
+                (st.x[d], st.v[d]) = (x, v);
+            }
+        }
     }
 
-    /// Starts a step of `dt` s: every rail mode's change under its own springs and dampers
-    /// and the sleepers' side of the pads.
+    /// Starts a step of `dt` s: every wavenumber's velocity change under its own springs and
+    /// dampers.
     pub fn begin(&mut self, dt: f64) {
-        let (b, pl, pv) = (
-            self.p.seat_half_distance,
-            self.p.pad_lateral,
-            self.p.pad_vertical,
-        );
-        for (side, sign) in SIDES.iter().enumerate() {
-            for dir in 0..2 {
-                for (f, sl) in self.nodes[0].iter_mut().zip(&self.sleepers) {
-                    *f = if dir == 0 {
-                        pl.stiffness * sl.y.x + pl.damping * sl.y.v
-                    } else {
-                        pv.stiffness * (sl.z.x + sign * b * sl.roll.x)
-                            + pv.damping * (sl.z.v + sign * b * sl.roll.v)
-                    };
-                }
-                let rail = &mut self.rails[side][dir];
-                // Modal force Σ_j φ_k(x_j)·f_j: the DST-I of the nodal forces.
-                rail.nodes_from_modes(&self.nodes[0], &self.sines, &mut self.modal);
-                rail.begin(dt, &self.modal);
-            }
+        if dt != self.dt {
+            self.vertical.iter_mut().for_each(|s| s.factor(dt));
+            self.lateral.iter_mut().for_each(|s| s.factor(dt));
+            self.dt = dt;
+        }
+        for (st, sys) in self.v_state.iter_mut().zip(&self.vertical) {
+            let bend = sys.bend.component_mul(&(st.x + st.v * dt));
+            st.dv = sys.inv * ((sys.k * st.x + bend + sys.c * st.v) * -dt);
+        }
+        for (st, sys) in self.l_state.iter_mut().zip(&self.lateral) {
+            let bend = sys.bend.component_mul(&(st.x + st.v * dt));
+            st.dv = sys.inv * ((sys.k * st.x + bend + sys.c * st.v) * -dt);
         }
     }
 
     /// Rail `side`'s velocity change so far in the step at `s` in direction `dir` (0 lateral,
-    /// 1 vertical), m/s, and its mobility there, m/s per N·s.
+    /// 1 vertical), m/s, and its mobility there (m/s per N·s of impulse), each wavenumber
+    /// solved whole (the sleepers and ballast yield within the step).
     pub fn free(&mut self, side: usize, dir: usize, s: f64) -> (f64, f64) {
-        let x = self.local(s);
-        self.rails[side][dir].free(x, &mut self.phi)
+        self.sines_at(s);
+        let (r, g) = (RAIL[side], 2.0 / self.p.bays as f64);
+        let (mut dv, mut w) = (0.0, 0.0);
+        if dir == 0 {
+            for ((sn, st), sys) in self.sines.iter().zip(&self.l_state).zip(&self.lateral) {
+                dv += sn * st.dv[r];
+                w += g * sn * sn * sys.inv[(r, r)];
+            }
+        } else {
+            for ((sn, st), sys) in self.sines.iter().zip(&self.v_state).zip(&self.vertical) {
+                dv += sn * st.dv[r];
+                w += g * sn * sn * sys.inv[(r, r)];
+            }
+        }
+        (dv, w)
     }
 
     /// An impulse on rail `side` at `s` in direction `dir` (N·s).
     pub fn impulse(&mut self, side: usize, dir: usize, s: f64, i: f64) {
-        let x = self.local(s);
-        self.rails[side][dir].impulse(x, i, &mut self.phi);
+        self.sines_at(s);
+        let (r, g) = (RAIL[side], 2.0 / self.p.bays as f64 * i);
+        if dir == 0 {
+            for ((sn, st), sys) in self.sines.iter().zip(&mut self.l_state).zip(&self.lateral) {
+                st.dv += sys.inv.column(r) * (g * sn);
+            }
+        } else {
+            for ((sn, st), sys) in self.sines.iter().zip(&mut self.v_state).zip(&self.vertical) {
+                st.dv += sys.inv.column(r) * (g * sn);
+            }
+        }
     }
 
-    /// Ends the step: the rails move, then the sleepers, then the ballast.
+    /// Ends the step: velocities take their change, displacements move with them.
     pub fn end(&mut self, dt: f64) {
-        let p = self.p;
-        let n = self.sleepers.len();
-        // Rail nodal displacement and velocity, [side][dir], after the rails' step.
-        let mut nodal = [
-            [(vec![0.0; n], vec![0.0; n]), (vec![0.0; n], vec![0.0; n])],
-            [(vec![0.0; n], vec![0.0; n]), (vec![0.0; n], vec![0.0; n])],
-        ];
-        for (side, rails) in self.rails.iter_mut().enumerate() {
-            for (dir, rail) in rails.iter_mut().enumerate() {
-                rail.end(dt);
-                let (w, v) = &mut nodal[side][dir];
-                rail.nodes_from_modes(&rail.q, &self.sines, w);
-                rail.nodes_from_modes(&rail.v, &self.sines, v);
-            }
+        for st in &mut self.v_state {
+            st.v += st.dv;
+            st.x += st.v * dt;
         }
-        let (b, pv, pl, bal) = (
-            p.seat_half_distance,
-            p.pad_vertical,
-            p.pad_lateral,
-            p.ballast,
-        );
-        let (kz, cz) = (
-            2.0 * (pv.stiffness + bal.stiffness),
-            2.0 * (pv.damping + bal.damping),
-        );
-        let (ky, cy) = (
-            2.0 * pl.stiffness + p.sleeper_lateral.stiffness,
-            2.0 * pl.damping + p.sleeper_lateral.damping,
-        );
-        for (j, (sl, bl)) in self.sleepers.iter_mut().zip(&self.ballast).enumerate() {
-            let (mut fz, mut mx, mut fy) = (0.0, 0.0, 0.0);
-            for (side, sign) in SIDES.iter().enumerate() {
-                let seat = sl.z.x + sign * b * sl.roll.x;
-                let seat_v = sl.z.v + sign * b * sl.roll.v;
-                let f = pv.stiffness * (nodal[side][1].0[j] - seat)
-                    + pv.damping * (nodal[side][1].1[j] - seat_v)
-                    - bal.stiffness * (seat - bl[side].x)
-                    - bal.damping * (seat_v - bl[side].v);
-                fz += f;
-                mx += sign * b * f;
-                fy += pl.stiffness * (nodal[side][0].0[j] - sl.y.x)
-                    + pl.damping * (nodal[side][0].1[j] - sl.y.v);
-            }
-            fy -= p.sleeper_lateral.stiffness * sl.y.x + p.sleeper_lateral.damping * sl.y.v;
-            sl.z.step(fz, p.sleeper_mass, kz, cz, dt);
-            sl.roll
-                .step(mx, p.sleeper_roll_inertia, b * b * kz, b * b * cz, dt);
-            sl.y.step(fy, p.sleeper_mass, ky, cy, dt);
-        }
-        let (sh, sg) = (p.ballast_shear, p.subgrade);
-        let kb = bal.stiffness + sg.stiffness + 2.0 * sh.stiffness;
-        let cb = bal.damping + sg.damping + 2.0 * sh.damping;
-        let old = self.ballast.clone();
-        for (j, (bl, sl)) in self.ballast.iter_mut().zip(&self.sleepers).enumerate() {
-            for (side, sign) in SIDES.iter().enumerate() {
-                let seat = sl.z.x + sign * b * sl.roll.x;
-                let seat_v = sl.z.v + sign * b * sl.roll.v;
-                let me = old[j][side];
-                let nb = |k: Option<usize>| {
-                    k.and_then(|k| old.get(k))
-                        .map_or(Dof::default(), |d| d[side])
-                };
-                let (l, r) = (nb(j.checked_sub(1)), nb(Some(j + 1)));
-                let f = bal.stiffness * (seat - me.x) + bal.damping * (seat_v - me.v)
-                    - sg.stiffness * me.x
-                    - sg.damping * me.v
-                    - sh.stiffness * (2.0 * me.x - l.x - r.x)
-                    - sh.damping * (2.0 * me.v - l.v - r.v);
-                bl[side].step(f, p.ballast_mass, kb, cb, dt);
-            }
+        for st in &mut self.l_state {
+            st.v += st.dv;
+            st.x += st.v * dt;
         }
     }
 
@@ -297,4 +357,8 @@ impl TrackDynamics {
             self.step(dt, loads);
         }
     }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

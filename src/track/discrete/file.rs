@@ -166,6 +166,13 @@ impl DiscreteFile {
                 d.subgrade,
             )?,
         };
+        if !(0.4..=1.0).contains(&p.spacing) {
+            return Err(Error::config(
+                path,
+                "rail_support.discrete.sleeper_spacing_m",
+                format!("must lie in 0.4–1.0 m, got {} m", p.spacing),
+            ));
+        }
         if p.window() < 20.0 {
             return Err(Error::config(
                 path,

@@ -6,8 +6,9 @@
 //! fastener is a rail pad (vertical and lateral spring and damper) to a rigid sleeper (vertical,
 //! lateral and roll); under each rail seat a ballast block on the subgrade, coupled to its
 //! neighbours in shear. With the fasteners evenly spaced and as many modes as fasteners the
-//! modes' values at the fasteners are a discrete sine transform (DST-I), so the pads' own
-//! stiffness is diagonal in the modes and the window can shift by whole bays exactly.
+//! modes' values at the fasteners are a discrete sine transform (DST-I), and so are the
+//! sleepers' and the ballast's fields: the track steps one wavenumber at a time
+//! ([`TrackDynamics`]), and the window shifts by whole bays exactly.
 //!
 //! What the model leaves out (stated, not hidden):
 //! - **shear and rotary inertia** (Euler–Bernoulli): the pinned–pinned frequency would sit at
@@ -26,12 +27,10 @@
 //! sleeper lateral, ballast shear, rail Iz); the sleeper's roll inertia and rail-seat distance
 //! are estimates.
 
-mod beam;
 mod dynamics;
 mod file;
 mod receptance;
 
-pub use beam::Beam;
 pub use dynamics::{Load, TrackDynamics};
 pub(super) use file::DiscreteFile;
 pub use receptance::{cut_on_frequencies, receptance};
