@@ -175,3 +175,38 @@ fn print_summary(track: &Track) {
         None => println!("  no irregularities (smooth track)"),
     }
 }
+
+/// `railforce validate track`: the discrete track's checks (the file's parameters, else the
+/// default set), measured against expected; an error on a miss.
+pub fn validate_discrete(track: Option<&std::path::Path>) -> Result<()> {
+    let p = match track {
+        None => railforce::track::discrete::DiscreteSupport::default(),
+        Some(t) => {
+            let mut spec = TrackSpec::load(&super::builtin::resolve(t)?)?;
+            spec.set_rail_model("discrete")?;
+            spec.discrete_rails.context("set above")?
+        }
+    };
+    println!(
+        "rails on discrete sleepers: {} bays of {} m, β {:.3} /m (Winkler, the seat's chain over the spacing)",
+        p.bays,
+        p.spacing,
+        p.beta()
+    );
+    let mut misses = 0;
+    for c in railforce::track::discrete::checks(&p) {
+        let ok = c.passes();
+        misses += usize::from(!ok);
+        println!(
+            "  {} {}: {:.4} {} against {:.4} (±{:.0} %)",
+            if ok { "pass" } else { "MISS" },
+            c.name,
+            c.measured,
+            c.unit,
+            c.expected,
+            100.0 * c.tolerance
+        );
+    }
+    anyhow::ensure!(misses == 0, "{misses} track check(s) missed");
+    Ok(())
+}

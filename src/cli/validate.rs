@@ -84,6 +84,14 @@ enum What {
         #[arg(long, default_value = "vehicles/restrained_wheelset.toml")]
         restrained: PathBuf,
     },
+    /// Rails on discrete sleepers against closed forms (physics.md §3.3): a static load and
+    /// two loads against the Winkler beam, a load moving at 100 km/h, the receptance's peaks
+    /// against the cut-on frequencies. Exits non-zero on a miss.
+    Track {
+        /// Track file whose `[rail_support.discrete]` is checked [default: the default set].
+        #[arg(long)]
+        track: Option<PathBuf>,
+    },
 }
 
 pub fn run(args: ValidateArgs) -> Result<()> {
@@ -115,6 +123,7 @@ pub fn run(args: ValidateArgs) -> Result<()> {
             wheelset,
             restrained,
         } => dynamics(&vehicle, &empty, &wheelset, &restrained),
+        What::Track { track } => super::track::validate_discrete(track.as_deref()),
     }
 }
 

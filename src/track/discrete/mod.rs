@@ -27,10 +27,12 @@
 //! sleeper lateral, ballast shear, rail Iz); the sleeper's roll inertia and rail-seat distance
 //! are estimates.
 
+mod checks;
 mod dynamics;
 mod file;
 mod receptance;
 
+pub use checks::{Check, checks};
 pub use dynamics::{Load, TrackDynamics};
 pub(super) use file::DiscreteFile;
 pub use receptance::{cut_on_frequencies, receptance};
