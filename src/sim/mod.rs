@@ -270,41 +270,14 @@ impl<'a> Simulation<'a> {
         // takes the Hertz spring into the wheelsets' solve only).
         let beams = match track.spec().discrete_rails {
             None => None,
-            Some(p) => {
-                if cfg
-                    .integrator
-                    .shares(cfg.dt)
-                    .is_none_or(|s| s.alpha_dt == 0.0)
-                {
-                    return Err(Error::Domain(format!(
-                        "track '{}' has rails on discrete sleepers: they run with the integrator that takes the Hertz spring into the wheelsets' solve (linearly-implicit-hertz, the default), not {} (the rail's modal mass under a wheel is tens of kg: an explicit Hertz spring on it bursts)",
-                        track.spec().name,
-                        cfg.integrator.name()
-                    )));
-                }
-                let ws: Vec<f64> = (vehicle.contact.wheelsets.iter())
-                    .map(|&w| start + vehicle.bodies[w].position.x)
-                    .collect();
-                // Each end of the window at least 6/β beyond the outer wheels (the basin down
-                // to e^(−6), 0.25 %), with half a bay for the window's shifts.
-                let span = ws.iter().fold(f64::MIN, |a, &b| a.max(b))
-                    - ws.iter().fold(f64::MAX, |a, &b| a.min(b));
-                let needed = span + 12.0 / p.beta() + p.spacing;
-                if p.window() < needed {
-                    return Err(Error::Domain(format!(
-                        "track '{}': rail_support.discrete.window_bays = {} ({:.1} m) is too short for vehicle '{}' (wheels over {:.1} m): the window needs {:.1} m ({} bays of {} m)",
-                        track.spec().name,
-                        p.bays,
-                        p.window(),
-                        vehicle.name,
-                        span,
-                        needed,
-                        (needed / p.spacing).ceil(),
-                        p.spacing
-                    )));
-                }
-                Some(rail_beams::settled(p, &ws, static_load, cfg.dt))
-            }
+            Some(p) => Some(rail_beams::settled(
+                p,
+                vehicle,
+                track,
+                start,
+                static_load,
+                &cfg,
+            )?),
         };
         let rail_z0 = match &beams {
             Some((_, sag)) => *sag,

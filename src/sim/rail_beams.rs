@@ -15,17 +15,50 @@
 
 use super::Simulation;
 use super::wheelset_solve::{Inverse, RailState, THETA, with_rail_rows};
+use crate::error::{Error, Result};
 use crate::track::discrete::{DiscreteSupport, Load, TrackDynamics};
 use nalgebra::{Matrix2, Matrix6, Vector2, Vector6};
 
-/// The track settled under the wagon's static wheel loads (wheelsets at `wheel_s`, each
-/// wheel `static_load` N) at the step `dt`, and the rails' mean sag under the wheels, m.
+/// The track settled under the wagon's static wheel loads (the wagon's first body at `start`,
+/// each wheel `static_load` N) at the run's step, and the rails' mean sag under the wheels, m;
+/// refused with the reason when the run's integrator cannot take the beams or the window is
+/// too short for the wagon.
 pub(super) fn settled(
     p: DiscreteSupport,
-    wheel_s: &[f64],
+    vehicle: &crate::vehicle::Vehicle,
+    track: &crate::track::Track,
+    start: f64,
     static_load: f64,
-    dt: f64,
-) -> (Box<TrackDynamics>, f64) {
+    cfg: &super::SimConfig,
+) -> Result<(Box<TrackDynamics>, f64)> {
+    if (cfg.integrator.shares(cfg.dt)).is_none_or(|s| s.alpha_dt == 0.0) {
+        return Err(Error::Domain(format!(
+            "track '{}' has rails on discrete sleepers: they run with the integrator that takes the Hertz spring into the wheelsets' solve (linearly-implicit-hertz, the default), not {} (the rail's modal mass under a wheel is tens of kg: an explicit Hertz spring on it bursts)",
+            track.spec().name,
+            cfg.integrator.name()
+        )));
+    }
+    let wheel_s: Vec<f64> = (vehicle.contact.wheelsets.iter())
+        .map(|&w| start + vehicle.bodies[w].position.x)
+        .collect();
+    // Each end of the window at least 6/β beyond the outer wheels (the basin down to e^(−6),
+    // 0.25 %), with a bay for the window's shifts.
+    let span = wheel_s.iter().fold(f64::MIN, |a, &b| a.max(b))
+        - wheel_s.iter().fold(f64::MAX, |a, &b| a.min(b));
+    let needed = span + 12.0 / p.beta() + p.spacing;
+    if p.window() < needed {
+        return Err(Error::Domain(format!(
+            "track '{}': rail_support.discrete.window_bays = {} ({:.1} m) is too short for vehicle '{}' (wheels over {:.1} m): the window needs {:.1} m ({} bays of {} m)",
+            track.spec().name,
+            p.bays,
+            p.window(),
+            vehicle.name,
+            span,
+            needed,
+            (needed / p.spacing).ceil(),
+            p.spacing
+        )));
+    }
     let centre = wheel_s.iter().sum::<f64>() / wheel_s.len().max(1) as f64;
     let mut t = TrackDynamics::new(p, centre);
     let loads: Vec<Load> = wheel_s
@@ -39,13 +72,13 @@ pub(super) fn settled(
             })
         })
         .collect();
-    t.settle(dt, 1.5, &loads);
+    t.settle(cfg.dt, 1.5, &loads);
     let sag = wheel_s
         .iter()
         .flat_map(|&s| [t.rail(0, s)[2], t.rail(1, s)[2]])
         .sum::<f64>()
         / (2 * wheel_s.len()).max(1) as f64;
-    (Box::new(t), sag)
+    Ok((Box::new(t), sag))
 }
 
 impl Simulation<'_> {
