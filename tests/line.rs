@@ -331,3 +331,58 @@ fn revised_element_keys_are_checked() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The plan key `rail_support`: the plan's for every condition, a condition's own over it; a
+/// data set of the curve on sleepers generates (at 0.5 ms, the step on sleepers) with the
+/// wagon's weight on its wheels; a lumped track asked of a file without one, or an unknown
+/// model, is refused naming the key.
+#[test]
+fn a_plan_puts_its_runs_on_sleepers() {
+    let dir = temp("sleepers");
+    let conditions = "[[condition]]\nname = \"c\"\ntrack = \"r400.toml\"\nspeed_kmh = 60.0\nstart_m = 150.0\nseeds = [1]\n\
+         [[condition]]\nname = \"d\"\ntrack = \"r400.toml\"\nspeed_kmh = 60.0\nstart_m = 150.0\nseeds = [1]\nrail_support = \"rigid\"\n";
+    let p = plan(&dir, "rail_support = \"discrete\"", conditions);
+    assert_eq!(p.conditions[0].rail_support.as_deref(), Some("discrete"));
+    assert_eq!(p.conditions[1].rail_support.as_deref(), Some("rigid"));
+    let out = dir.join("out");
+    let m = dataset::generate(&p, &opts(&out), &|_| {}).unwrap();
+    assert_eq!(m.runs.len(), 2);
+    let ds = DataSet::load(&out).unwrap();
+    let q: f64 = ["w1l_force_z", "w1r_force_z", "w2l_force_z", "w2r_force_z"]
+        .iter()
+        .map(|c| mean(&ds, 0, c))
+        .sum();
+    let weight = Vehicle::load(&root().join("vehicles/c80.toml"))
+        .unwrap()
+        .mass()
+        * 9.81
+        / 2.0;
+    assert!((q / weight - 1.0).abs() < 0.05, "{q} N against {weight} N");
+    let p = plan(
+        &dir,
+        "rail_support = \"lumped\"",
+        conditions
+            .split("[[condition]]\nname = \"d\"")
+            .next()
+            .unwrap(),
+    );
+    let e = dataset::generate(&p, &opts(&dir.join("out2")), &|_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("c.rail_support") && e.contains("no lumped"),
+        "{e}"
+    );
+    std::fs::write(
+        dir.join("bad.plan.toml"),
+        std::fs::read_to_string(dir.join("line.plan.toml"))
+            .unwrap()
+            .replace("\"lumped\"", "\"beams\""),
+    )
+    .unwrap();
+    let e = Plan::load(&dir.join("bad.plan.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("rail_support") && e.contains("beams"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
