@@ -50,8 +50,12 @@ struct System<const D: usize> {
     bend: SVector<f64, D>,
     k: nalgebra::SMatrix<f64, D, D>,
     c: nalgebra::SMatrix<f64, D, D>,
-    /// `(M + Δt/2·C + Δt²/4·K)⁻¹` at the current step.
+    /// `(M + Δt/2·C + Δt²/12·K + Δt²·B)⁻¹` at the current step (`B` the bending).
     inv: nalgebra::SMatrix<f64, D, D>,
+    /// The step's free velocity change from the displacement and from the velocity:
+    /// `−Δt·inv·(K + B)` and `−Δt·inv·(C + Δt·B)`.
+    from_x: nalgebra::SMatrix<f64, D, D>,
+    from_v: nalgebra::SMatrix<f64, D, D>,
     m: SVector<f64, D>,
 }
 
@@ -68,6 +72,9 @@ impl<const D: usize> System<D> {
             + self.k * (dt * dt / 12.0)
             + nalgebra::SMatrix::<f64, D, D>::from_diagonal(&self.bend) * (dt * dt);
         self.inv = a.try_inverse().unwrap_or_else(nalgebra::SMatrix::zeros);
+        let bend = nalgebra::SMatrix::<f64, D, D>::from_diagonal(&self.bend);
+        self.from_x = self.inv * (self.k + bend) * -dt;
+        self.from_v = self.inv * (self.c + bend * dt) * -dt;
     }
 }
 
@@ -105,8 +112,10 @@ pub struct TrackDynamics {
     dt: f64,
     v_state: Vec<State<6>>,
     l_state: Vec<State<3>>,
-    /// `sin(kπx/L)` at the last position asked for, k = 1 … N−1.
+    /// `sin(kπx/L)` at the last position asked for, k = 1 … N−1, and that position relative
+    /// to the window's start.
     sines: Vec<f64>,
+    sines_at: f64,
     /// `sin(kπj/N)`, (N−1)², for the window's shifts.
     table: Vec<f64>,
 }
@@ -128,6 +137,8 @@ impl TrackDynamics {
                 k: Matrix6::zeros(),
                 c: Matrix6::zeros(),
                 inv: Matrix6::zeros(),
+                from_x: Matrix6::zeros(),
+                from_v: Matrix6::zeros(),
                 m: Vector6::new(
                     ms,
                     ms,
@@ -158,6 +169,8 @@ impl TrackDynamics {
                 k: Matrix3::zeros(),
                 c: Matrix3::zeros(),
                 inv: Matrix3::zeros(),
+                from_x: Matrix3::zeros(),
+                from_v: Matrix3::zeros(),
                 m: Vector3::new(ms, ms, p.sleeper_mass),
             };
             for side in 0..2 {
@@ -185,6 +198,7 @@ impl TrackDynamics {
             v_state: vec![State::default(); n],
             l_state: vec![State::default(); n],
             sines: vec![0.0; n],
+            sines_at: f64::NAN,
             table,
             p,
         }
@@ -205,6 +219,10 @@ impl TrackDynamics {
     fn sines_at(&mut self, s: f64) {
         let l = self.p.window();
         let x = (s - self.start).clamp(1e-6 * l, (1.0 - 1e-6) * l);
+        if x == self.sines_at {
+            return;
+        }
+        self.sines_at = x;
         let a = std::f64::consts::PI * x / l;
         let (c2, mut prev, mut cur) = (2.0 * a.cos(), 0.0, a.sin());
         for p in self.sines.iter_mut() {
@@ -284,12 +302,10 @@ impl TrackDynamics {
             self.dt = dt;
         }
         for (st, sys) in self.v_state.iter_mut().zip(&self.vertical) {
-            let bend = sys.bend.component_mul(&(st.x + st.v * dt));
-            st.dv = sys.inv * ((sys.k * st.x + bend + sys.c * st.v) * -dt);
+            st.dv = sys.from_x * st.x + sys.from_v * st.v;
         }
         for (st, sys) in self.l_state.iter_mut().zip(&self.lateral) {
-            let bend = sys.bend.component_mul(&(st.x + st.v * dt));
-            st.dv = sys.inv * ((sys.k * st.x + bend + sys.c * st.v) * -dt);
+            st.dv = sys.from_x * st.x + sys.from_v * st.v;
         }
     }
 
