@@ -161,8 +161,9 @@ pub struct Stepping {
 
 /// The longest step a run on rails on sleepers takes ([`crate::track::discrete`]) unless
 /// told otherwise. At 5/6 ms the rail under a flanging wheel (a bay's rail mass, 36 kg, against
-/// the flange's Hertz stiffness) is not followed: on R 400 m at 100 km/h, Q's standard
-/// deviation 90 % off the same model at 0.1 ms; at 0.5 ms 0.27 %, FL's 0.89 %, Y/Q rms 1.7 %
+/// the flange's Hertz stiffness) is not followed: on R 400 m at 100 km/h the run chatters;
+/// at 0.5 ms Q's standard deviation is 0.33 % off the same model at 0.1 ms, FL's 0.93 %, Y/Q
+/// rms 1.7 %
 /// (physics.md §3.3; `railforce bench step --rail-support discrete --reference 1e-4
 /// --reference-integrator linearly-implicit-hertz`).
 pub const MAX_STEP_ON_BEAMS: f64 = 5e-4;
