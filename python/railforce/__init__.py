@@ -73,6 +73,7 @@ def simulate(
     as_frame: bool = False,
     consist: str = "none",
     position: Optional[float] = None,
+    rail_support: Optional[str] = None,
 ):
     """One run of ``vehicle`` on ``track``, exactly as ``railforce simulate`` makes it.
 
@@ -86,6 +87,8 @@ def simulate(
     ``"daqin_20kt"``, their ``_empty`` forms, or a consist file) and ``position`` (the
     wagon's place as a fraction of the train from the head) as ``--consist`` and
     ``--position`` take them; a run in a train adds the ``coupler_*`` channels.
+    ``rail_support`` (``"rigid"``, ``"lumped"``, ``"discrete"``: rails on sleepers, 0.5 ms
+    unless ``dt``) as ``--rail-support`` chooses it over the track file's.
     """
     cols = _native.simulate(
         os.fspath(track),
@@ -100,6 +103,7 @@ def simulate(
         bool(keep_going),
         str(consist),
         None if position is None else float(position),
+        None if rail_support is None else str(rail_support),
     )
     return _frame(cols, as_frame)
 

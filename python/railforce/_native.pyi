@@ -31,7 +31,8 @@ def builtins() -> List[str]: ...
 def simulate(
     track: str, vehicle: str, speed_kmh: float, duration_s: float, seed: Optional[int],
     channels: Optional[List[str]], settle_s: float, dt: Optional[float], integrator: Optional[str],
-    keep_going: bool,
+    keep_going: bool, consist: str = "none", position: Optional[float] = None,
+    rail_support: Optional[str] = None,
 ) -> Dict[str, npt.NDArray[np.float64]]: ...
 def generate(
     plan: str, out: str, shard: Optional[str], format: str, jobs: Optional[int],

@@ -156,3 +156,20 @@ def test_threads_running_two_simulations_at_once_finish_faster_than_one_after_th
     parallel = time.perf_counter() - t0
     # Two cores and the interpreter released: well under the serial time.
     assert parallel < 0.8 * serial, (parallel, serial)
+
+
+def test_simulate_on_sleepers_matches_the_cli(cli, tmp_path):
+    out = tmp_path / "sleepers.npz"
+    subprocess.run(
+        [str(cli), "simulate", "--track", "curve_r400", "--speed-kmh", "60", "--duration", "0.5",
+         "--settle", "0.5", "--seed", "7", "--rail-support", "discrete", "--out", str(out)],
+        check=True, capture_output=True,
+    )
+    ref = np.load(out)
+    py = railforce.simulate(track="curve_r400", speed_kmh=60, duration_s=0.5, settle_s=0.5, seed=7,
+                            rail_support="discrete")
+    for name in ("w1l_force_z", "w1l_force_y", "carbody_acc_z"):
+        np.testing.assert_array_equal(py[name], ref[name], err_msg=name)
+    with pytest.raises(ValueError, match="discrete sleepers"):
+        railforce.simulate(track="curve_r400", duration_s=0.5, rail_support="discrete",
+                           integrator="heun")

@@ -75,7 +75,7 @@ fn dict_of_arrays<'py>(
 
 /// One run, as `railforce simulate` makes it; returns its recorded channels.
 #[pyfunction]
-#[pyo3(signature = (track, vehicle, speed_kmh, duration_s, seed, channels, settle_s, dt, integrator, keep_going, consist="none", position=None))]
+#[pyo3(signature = (track, vehicle, speed_kmh, duration_s, seed, channels, settle_s, dt, integrator, keep_going, consist="none", position=None, rail_support=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -91,6 +91,7 @@ fn simulate<'py>(
     keep_going: bool,
     consist: &str,
     position: Option<f64>,
+    rail_support: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = RunRequest {
         speed_kmh,
@@ -111,7 +112,13 @@ fn simulate<'py>(
     let rec = py
         .detach(|| -> crate::Result<output::Recording> {
             let vehicle = Vehicle::load(&vehicle)?;
-            let track = Track::new(TrackSpec::load(&track)?, seed);
+            let mut spec = TrackSpec::load(&track)?;
+            if let Some(m) = rail_support {
+                spec.set_rail_model(m)?;
+            }
+            let mut cfg = cfg;
+            cfg.dt = request.stepping.step_on(&spec);
+            let track = Track::new(spec, seed);
             let mut sim = Simulation::new(&vehicle, &track, cfg)?;
             output::record(&mut sim, |_| {})
         })
