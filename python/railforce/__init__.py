@@ -87,7 +87,7 @@ def simulate(
     ``"daqin_20kt"``, their ``_empty`` forms, or a consist file) and ``position`` (the
     wagon's place as a fraction of the train from the head) as ``--consist`` and
     ``--position`` take them; a run in a train adds the ``coupler_*`` channels.
-    ``rail_support`` (``"rigid"``, ``"lumped"``, ``"discrete"``: rails on sleepers, 0.5 ms
+    ``rail_support`` (``"rigid"``, ``"lumped"``, ``"discrete"``: rails on sleepers, 0.25 ms
     unless ``dt``) as ``--rail-support`` chooses it over the track file's.
     """
     cols = _native.simulate(

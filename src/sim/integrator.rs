@@ -161,12 +161,12 @@ pub struct Stepping {
 
 /// The longest step a run on rails on sleepers takes ([`crate::track::discrete`]) unless
 /// told otherwise. At 5/6 ms the rail under a flanging wheel (a bay's rail mass, 36 kg, against
-/// the flange's Hertz stiffness) is not followed: on R 400 m at 100 km/h the run chatters;
-/// at 0.5 ms Q's standard deviation is 0.33 % off the same model at 0.1 ms, FL's 0.93 %, Y/Q
-/// rms 1.7 %
-/// (physics.md §3.3; `railforce bench step --rail-support discrete --reference 1e-4
-/// --reference-integrator linearly-implicit-hertz`).
-pub const MAX_STEP_ON_BEAMS: f64 = 5e-4;
+/// the flange's Hertz stiffness) is not followed: on R 400 m at 100 km/h the run chatters.
+/// 0.25 ms holds every wheel's Y/Q rms and Q standard deviation and FL's within 1 % of the same
+/// model at 0.05 ms (worst 0.72 %), where 0.5 ms is 1.8–2.2 % off in Y/Q rms (physics.md §3.3;
+/// `railforce bench step --rail-support discrete --reference 5e-5 --reference-integrator
+/// linearly-implicit-hertz`).
+pub const MAX_STEP_ON_BEAMS: f64 = 2.5e-4;
 
 impl PartialEq for Stepping {
     fn eq(&self, other: &Self) -> bool {
@@ -176,8 +176,8 @@ impl PartialEq for Stepping {
 
 impl Stepping {
     /// The step a run on the track `spec` takes: the given step, else the integrator's own,
-    /// at most [`MAX_STEP_ON_BEAMS`] on rails on sleepers (the sample's whole fraction below
-    /// it: 0.5 ms for the 5 ms sample).
+    /// at most [`MAX_STEP_ON_BEAMS`] on rails on sleepers (a whole fraction of the 5 ms
+    /// sample).
     pub fn step_on(&self, spec: &crate::track::TrackSpec) -> f64 {
         if self.given || spec.discrete_rails.is_none() || self.dt <= MAX_STEP_ON_BEAMS {
             self.dt
