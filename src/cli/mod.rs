@@ -186,7 +186,7 @@ enum Command {
     /// and GBDT, sweep two SNRs, and write the report (demo/index.html).
     Demo(experiment::DemoArgs),
     /// Check railforce against reference solutions and in closed loop (`validate contact`,
-    /// `validate dynamics`, `validate identify`).
+    /// `validate dynamics`, `validate track`, `validate identify`).
     #[command(
         after_help = "Examples:\n  railforce validate contact\n  railforce validate identify --model models/demo --plan demo"
     )]
