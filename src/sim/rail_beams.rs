@@ -63,14 +63,7 @@ pub(super) fn settled(
     let mut t = TrackDynamics::new(p, centre);
     let loads: Vec<Load> = wheel_s
         .iter()
-        .flat_map(|&s| {
-            [0, 1].map(|side| Load {
-                side,
-                s,
-                lateral: 0.0,
-                vertical: -static_load,
-            })
-        })
+        .flat_map(|&s| Load::wheelset(s, 0.0, -static_load))
         .collect();
     t.settle(cfg.dt, 1.5, &loads);
     let sag = wheel_s

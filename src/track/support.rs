@@ -122,6 +122,23 @@ impl RailSupportFile {
     }
 }
 
+/// A track-file number that must be positive (at least zero where `zero_ok`), its error
+/// naming the file and `field`.
+pub(super) fn checked(path: &Path, field: String, v: f64, zero_ok: bool) -> Result<f64> {
+    if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) {
+        Ok(v)
+    } else {
+        Err(Error::config(
+            path,
+            field,
+            format!(
+                "must be {}, got {v}",
+                if zero_ok { "≥ 0" } else { "positive" }
+            ),
+        ))
+    }
+}
+
 impl RailSupport {
     fn from_file(f: &RailSupportFile, path: &Path) -> Result<Self> {
         let check = |field: &str, v: Option<f64>, zero_ok: bool| -> Result<f64> {
@@ -132,18 +149,7 @@ impl RailSupport {
                     "missing (the lumped model needs all six masses, stiffnesses and dampings)",
                 ));
             };
-            if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) {
-                Ok(v)
-            } else {
-                Err(Error::config(
-                    path,
-                    format!("rail_support.{field}"),
-                    format!(
-                        "must be {}, got {v}",
-                        if zero_ok { "≥ 0" } else { "positive" }
-                    ),
-                ))
-            }
+            checked(path, format!("rail_support.{field}"), v, zero_ok)
         };
         let support = RailSupport {
             lateral: Support {

@@ -116,4 +116,3 @@ pub(super) fn run(dir: &cv::Reference) -> Result<()> {
     println!("\nall gated comparisons within tolerance");
     Ok(())
 }
-

@@ -26,12 +26,7 @@ impl Check {
 
 /// A wheelset's two wheels at `s`, `p` N down each.
 fn pair(s: f64, p: f64) -> [Load; 2] {
-    [0, 1].map(|side| Load {
-        side,
-        s,
-        lateral: 0.0,
-        vertical: -p,
-    })
+    Load::wheelset(s, 0.0, -p)
 }
 
 /// Every check on the parameter set `p`: the static deflection under a load over a sleeper

@@ -14,17 +14,20 @@
 //! the rail's deflection there is `Σ_k a_k·sin(kπx/L)`.
 //!
 //! Each system steps as the vehicle's wheelsets do, symplectic Euler with its springs and
-//! dampers shared into the step's end: `(M + Δt/2·C + Δt²/4·K)·Δv = Δt·(F − K·x − C·v)`,
-//! `Δx = Δt·(v + Δv)` (the shares of the wheel's Hertz spring, §6 of physics.md, at α = ¼:
-//! stable at any step, a linear spring's frequency lowered to `ω/√(1 + ω²Δt²/4)`, no numerical
-//! damping), its inverse built once per step length. Backward Euler (`Δt²·K` and `Δt·C`
-//! whole) damped the 50–250 Hz track modes by ζ ≈ ω·Δt/2, 4 % off in Y/Q rms at 0.5 ms on
-//! R 400 m at 100 km/h; the trapezoidal rule's displacement `Δt·(v + Δv/2)` is not the one the
-//! wheel's solve takes for the rail, and burst. The nodal fields are needed only when the window shifts by whole bays
-//! (every 0.6 m of travel): the sines' transform and its inverse, exact.
+//! dampers shared into the step's end, its inverse built once per step length:
+//! `(M + Δt/2·C + Δt²/12·K + Δt²·B)·Δv = Δt·(F − K·x − B·(x + Δt·v) − C·v)`, `Δx = Δt·(v + Δv)`.
+//! `B`, the rails' bending and their own pads, is backward Euler: the bending modes up to
+//! 1.4 kHz, which no step of the run follows, are damped rather than left ringing (with no
+//! numerical damping on them, α = ¼, Q's standard deviation was 34 % off at 0.5 ms on
+//! R 400 m at 100 km/h). `K`, the rest of the pads, the sleepers and the ballast, takes Fox and
+//! Goodwin's share (α = 1/12: a linear spring's frequency right to fourth order, stable below
+//! ω·Δt = 2.45, no numerical damping); the damping `C` takes θ = ½. The trapezoidal rule's
+//! displacement `Δt·(v + Δv/2)` is not the one the wheel's solve takes for the rail, and burst.
+//! The nodal fields are needed only when the window shifts by whole bays (every 0.6 m of
+//! travel): the sines' transform and its inverse, exact.
 
 use super::DiscreteSupport;
-use nalgebra::{Matrix3, Matrix6, SVector, Vector3, Vector6};
+use nalgebra::{SVector, Vector3, Vector6};
 
 /// Left and right rail (track y positive to the left): the sign of a rail seat's lever
 /// about the sleeper's centre.
@@ -41,6 +44,18 @@ pub struct Load {
     pub lateral: f64,
     /// Vertical force, N.
     pub vertical: f64,
+}
+
+impl Load {
+    /// A wheelset's two wheels at `s`: `lateral` and `vertical` N on each rail.
+    pub fn wheelset(s: f64, lateral: f64, vertical: f64) -> [Load; 2] {
+        [0, 1].map(|side| Load {
+            side,
+            s,
+            lateral,
+            vertical,
+        })
+    }
 }
 
 /// One wavenumber's mass, stiffness and damping (`D` degrees of freedom).
@@ -60,6 +75,29 @@ struct System<const D: usize> {
 }
 
 impl<const D: usize> System<D> {
+    /// No spring yet, masses (or inertias) `m`.
+    fn new(m: SVector<f64, D>) -> Self {
+        let zero = nalgebra::SMatrix::<f64, D, D>::zeros();
+        System {
+            bend: SVector::zeros(),
+            k: zero,
+            c: zero,
+            inv: zero,
+            from_x: zero,
+            from_v: zero,
+            m,
+        }
+    }
+
+    /// The rails' own stiffness (their diagonal in `k`: the pads' rail side) moved into the
+    /// backward-Euler part beside their bending.
+    fn rails_backward_euler(&mut self) {
+        for side in RAIL {
+            self.bend[side] += self.k[(side, side)];
+            self.k[(side, side)] = 0.0;
+        }
+    }
+
     /// Adds a spring `k` and damper `c` whose elongation is `e·x`.
     fn spring(&mut self, e: SVector<f64, D>, k: f64, c: f64) {
         self.k += e * e.transpose() * k;
@@ -67,12 +105,12 @@ impl<const D: usize> System<D> {
     }
 
     fn factor(&mut self, dt: f64) {
+        let bend = nalgebra::SMatrix::<f64, D, D>::from_diagonal(&self.bend);
         let a = nalgebra::SMatrix::<f64, D, D>::from_diagonal(&self.m)
             + self.c * (0.5 * dt)
             + self.k * (dt * dt / 12.0)
-            + nalgebra::SMatrix::<f64, D, D>::from_diagonal(&self.bend) * (dt * dt);
+            + bend * (dt * dt);
         self.inv = a.try_inverse().unwrap_or_else(nalgebra::SMatrix::zeros);
-        let bend = nalgebra::SMatrix::<f64, D, D>::from_diagonal(&self.bend);
         self.from_x = self.inv * (self.k + bend) * -dt;
         self.from_v = self.inv * (self.c + bend * dt) * -dt;
     }
@@ -100,18 +138,83 @@ impl<const D: usize> Default for State<D> {
 /// right). Lateral: rails (left, right), sleeper sway.
 const RAIL: [usize; 2] = [0, 1];
 
+/// One direction of the track (lateral, `D` = 3, or vertical, 6): every wavenumber's system
+/// and state.
+#[derive(Debug, Clone)]
+struct Direction<const D: usize> {
+    systems: Vec<System<D>>,
+    states: Vec<State<D>>,
+}
+
+impl<const D: usize> Direction<D> {
+    fn new(systems: Vec<System<D>>) -> Self {
+        let states = vec![State::default(); systems.len()];
+        Direction { systems, states }
+    }
+
+    /// Rail `r`'s displacement and velocity at the point whose sines are `sines`.
+    fn point(&self, sines: &[f64], r: usize) -> (f64, f64) {
+        let (mut x, mut v) = (0.0, 0.0);
+        for (sn, st) in sines.iter().zip(&self.states) {
+            x += sn * st.x[r];
+            v += sn * st.v[r];
+        }
+        (x, v)
+    }
+
+    fn begin(&mut self) {
+        for (st, sys) in self.states.iter_mut().zip(&self.systems) {
+            st.dv = sys.from_x * st.x + sys.from_v * st.v;
+        }
+    }
+
+    /// Rail `r`'s velocity change so far and its mobility at the point of `sines`; `g` is
+    /// `2/N`.
+    fn free(&self, sines: &[f64], r: usize, g: f64) -> (f64, f64) {
+        let (mut dv, mut w) = (0.0, 0.0);
+        for ((sn, st), sys) in sines.iter().zip(&self.states).zip(&self.systems) {
+            dv += sn * st.dv[r];
+            w += g * sn * sn * sys.inv[(r, r)];
+        }
+        (dv, w)
+    }
+
+    /// An impulse on rail `r` at the point of `sines`, `g` its `2/N` share.
+    fn impulse(&mut self, sines: &[f64], r: usize, g: f64) {
+        for ((sn, st), sys) in sines.iter().zip(&mut self.states).zip(&self.systems) {
+            st.dv += sys.inv.column(r) * (g * sn);
+        }
+    }
+
+    fn end(&mut self, dt: f64) {
+        for st in &mut self.states {
+            st.v += st.dv;
+            st.x += st.v * dt;
+        }
+    }
+
+    /// Every field moved by `moved` (amplitudes in, amplitudes out).
+    fn shift(&mut self, moved: &impl Fn(Vec<f64>) -> Vec<f64>) {
+        for d in 0..D {
+            let x = moved(self.states.iter().map(|st| st.x[d]).collect());
+            let v = moved(self.states.iter().map(|st| st.v[d]).collect());
+            for ((st, x), v) in self.states.iter_mut().zip(x).zip(v) {
+                (st.x[d], st.v[d]) = (x, v);
+            }
+        }
+    }
+}
+
 /// The discrete track in its window.
 #[derive(Debug, Clone)]
 pub struct TrackDynamics {
     p: DiscreteSupport,
     /// Along-track position of the window's start (a sleeper position), m.
     start: f64,
-    vertical: Vec<System<6>>,
-    lateral: Vec<System<3>>,
+    vertical: Direction<6>,
+    lateral: Direction<3>,
     /// The step the inverses were built for, s.
     dt: f64,
-    v_state: Vec<State<6>>,
-    l_state: Vec<State<3>>,
     /// `sin(kπx/L)` at the last position asked for, k = 1 … N−1, and that position relative
     /// to the window's start.
     sines: Vec<f64>,
@@ -132,22 +235,14 @@ impl TrackDynamics {
         for k in 1..=n {
             let kappa4 = (k as f64 * std::f64::consts::PI / p.window()).powi(4);
             let shear = 2.0 * (1.0 - (k as f64 * std::f64::consts::PI / nb).cos());
-            let mut v = System::<6> {
-                bend: Vector6::zeros(),
-                k: Matrix6::zeros(),
-                c: Matrix6::zeros(),
-                inv: Matrix6::zeros(),
-                from_x: Matrix6::zeros(),
-                from_v: Matrix6::zeros(),
-                m: Vector6::new(
-                    ms,
-                    ms,
-                    p.sleeper_mass,
-                    p.sleeper_roll_inertia,
-                    p.ballast_mass,
-                    p.ballast_mass,
-                ),
-            };
+            let mut v = System::new(Vector6::new(
+                ms,
+                ms,
+                p.sleeper_mass,
+                p.sleeper_roll_inertia,
+                p.ballast_mass,
+                p.ballast_mass,
+            ));
             for (side, sign) in SIDES.iter().enumerate() {
                 let unit = |i: usize| Vector6::from_fn(|r, _| if r == i { 1.0 } else { 0.0 });
                 let seat = unit(2) + unit(3) * (sign * b);
@@ -159,20 +254,9 @@ impl TrackDynamics {
                 v.spring(unit(4 + side), sg.stiffness, sg.damping);
                 v.spring(unit(4 + side), shear * sh.stiffness, shear * sh.damping);
             }
-            for side in 0..2 {
-                v.bend[side] += v.k[(side, side)];
-                v.k[(side, side)] = 0.0;
-            }
+            v.rails_backward_euler();
             vertical.push(v);
-            let mut l = System::<3> {
-                bend: Vector3::zeros(),
-                k: Matrix3::zeros(),
-                c: Matrix3::zeros(),
-                inv: Matrix3::zeros(),
-                from_x: Matrix3::zeros(),
-                from_v: Matrix3::zeros(),
-                m: Vector3::new(ms, ms, p.sleeper_mass),
-            };
+            let mut l = System::new(Vector3::new(ms, ms, p.sleeper_mass));
             for side in 0..2 {
                 let rail = Vector3::from_fn(|r, _| if r == side { 1.0 } else { 0.0 });
                 l.bend[side] = p.spacing * p.rail_ei_lateral * kappa4;
@@ -181,10 +265,7 @@ impl TrackDynamics {
             }
             let sl = p.sleeper_lateral;
             l.spring(Vector3::z(), sl.stiffness, sl.damping);
-            for side in 0..2 {
-                l.bend[side] += l.k[(side, side)];
-                l.k[(side, side)] = 0.0;
-            }
+            l.rails_backward_euler();
             lateral.push(l);
         }
         let table = (0..n * n)
@@ -192,11 +273,9 @@ impl TrackDynamics {
             .collect();
         TrackDynamics {
             start: ((centre - 0.5 * p.window()) / p.spacing).round() * p.spacing,
-            vertical,
-            lateral,
+            vertical: Direction::new(vertical),
+            lateral: Direction::new(lateral),
             dt: 0.0,
-            v_state: vec![State::default(); n],
-            l_state: vec![State::default(); n],
             sines: vec![0.0; n],
             sines_at: f64::NAN,
             table,
@@ -237,14 +316,9 @@ impl TrackDynamics {
     /// vz]` (m, m/s; y to the left, z up).
     pub fn rail(&mut self, side: usize, s: f64) -> [f64; 4] {
         self.sines_at(s);
-        let mut r = [0.0; 4];
-        for ((sn, l), v) in self.sines.iter().zip(&self.l_state).zip(&self.v_state) {
-            r[0] += sn * l.x[RAIL[side]];
-            r[1] += sn * l.v[RAIL[side]];
-            r[2] += sn * v.x[RAIL[side]];
-            r[3] += sn * v.v[RAIL[side]];
-        }
-        r
+        let (y, vy) = self.lateral.point(&self.sines, RAIL[side]);
+        let (z, vz) = self.vertical.point(&self.sines, RAIL[side]);
+        [y, vy, z, vz]
     }
 
     /// Shifts the window by whole bays so that its centre is within half a bay of `centre`:
@@ -256,7 +330,7 @@ impl TrackDynamics {
         }
         self.start += n * self.p.spacing;
         let shift = n as i64;
-        let (len, g) = (self.v_state.len(), 2.0 / self.p.bays as f64);
+        let (len, g) = (self.sines.len(), 2.0 / self.p.bays as f64);
         let table = &self.table;
         // One field's amplitudes to the fasteners, shifted, and back.
         let moved = |amps: Vec<f64>| -> Vec<f64> {
@@ -277,36 +351,20 @@ impl TrackDynamics {
                 .map(|k| g * dot(&table[k * len..(k + 1) * len], &shifted))
                 .collect()
         };
-        for d in 0..6 {
-            let x = moved(self.v_state.iter().map(|st| st.x[d]).collect());
-            let v = moved(self.v_state.iter().map(|st| st.v[d]).collect());
-            for ((st, x), v) in self.v_state.iter_mut().zip(x).zip(v) {
-                (st.x[d], st.v[d]) = (x, v);
-            }
-        }
-        for d in 0..3 {
-            let x = moved(self.l_state.iter().map(|st| st.x[d]).collect());
-            let v = moved(self.l_state.iter().map(|st| st.v[d]).collect());
-            for ((st, x), v) in self.l_state.iter_mut().zip(x).zip(v) {
-                (st.x[d], st.v[d]) = (x, v);
-            }
-        }
+        self.vertical.shift(&moved);
+        self.lateral.shift(&moved);
     }
 
     /// Starts a step of `dt` s: every wavenumber's velocity change under its own springs and
     /// dampers.
     pub fn begin(&mut self, dt: f64) {
         if dt != self.dt {
-            self.vertical.iter_mut().for_each(|s| s.factor(dt));
-            self.lateral.iter_mut().for_each(|s| s.factor(dt));
+            self.vertical.systems.iter_mut().for_each(|s| s.factor(dt));
+            self.lateral.systems.iter_mut().for_each(|s| s.factor(dt));
             self.dt = dt;
         }
-        for (st, sys) in self.v_state.iter_mut().zip(&self.vertical) {
-            st.dv = sys.from_x * st.x + sys.from_v * st.v;
-        }
-        for (st, sys) in self.l_state.iter_mut().zip(&self.lateral) {
-            st.dv = sys.from_x * st.x + sys.from_v * st.v;
-        }
+        self.vertical.begin();
+        self.lateral.begin();
     }
 
     /// Rail `side`'s velocity change so far in the step at `s` in direction `dir` (0 lateral,
@@ -315,19 +373,11 @@ impl TrackDynamics {
     pub fn free(&mut self, side: usize, dir: usize, s: f64) -> (f64, f64) {
         self.sines_at(s);
         let (r, g) = (RAIL[side], 2.0 / self.p.bays as f64);
-        let (mut dv, mut w) = (0.0, 0.0);
         if dir == 0 {
-            for ((sn, st), sys) in self.sines.iter().zip(&self.l_state).zip(&self.lateral) {
-                dv += sn * st.dv[r];
-                w += g * sn * sn * sys.inv[(r, r)];
-            }
+            self.lateral.free(&self.sines, r, g)
         } else {
-            for ((sn, st), sys) in self.sines.iter().zip(&self.v_state).zip(&self.vertical) {
-                dv += sn * st.dv[r];
-                w += g * sn * sn * sys.inv[(r, r)];
-            }
+            self.vertical.free(&self.sines, r, g)
         }
-        (dv, w)
     }
 
     /// An impulse on rail `side` at `s` in direction `dir` (N·s).
@@ -335,26 +385,16 @@ impl TrackDynamics {
         self.sines_at(s);
         let (r, g) = (RAIL[side], 2.0 / self.p.bays as f64 * i);
         if dir == 0 {
-            for ((sn, st), sys) in self.sines.iter().zip(&mut self.l_state).zip(&self.lateral) {
-                st.dv += sys.inv.column(r) * (g * sn);
-            }
+            self.lateral.impulse(&self.sines, r, g);
         } else {
-            for ((sn, st), sys) in self.sines.iter().zip(&mut self.v_state).zip(&self.vertical) {
-                st.dv += sys.inv.column(r) * (g * sn);
-            }
+            self.vertical.impulse(&self.sines, r, g);
         }
     }
 
     /// Ends the step: velocities take their change, displacements move with them.
     pub fn end(&mut self, dt: f64) {
-        for st in &mut self.v_state {
-            st.v += st.dv;
-            st.x += st.v * dt;
-        }
-        for st in &mut self.l_state {
-            st.v += st.dv;
-            st.x += st.v * dt;
-        }
+        self.vertical.end(dt);
+        self.lateral.end(dt);
     }
 
     /// One whole step under loads held over it (the track alone: tests, checks).

@@ -37,20 +37,9 @@ impl DiscreteFile {
     /// The parameters, each key checked (`path` names the file in errors).
     pub fn support(&self, path: &Path) -> Result<DiscreteSupport> {
         let d = DiscreteSupport::default();
-        let get = |key: &str, v: Option<f64>, default: f64, zero_ok: bool| -> Result<f64> {
-            let v = v.unwrap_or(default);
-            if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) {
-                Ok(v)
-            } else {
-                Err(Error::config(
-                    path,
-                    format!("rail_support.discrete.{key}"),
-                    format!(
-                        "must be {}, got {v}",
-                        if zero_ok { "≥ 0" } else { "positive" }
-                    ),
-                ))
-            }
+        let get = |key: &str, v: Option<f64>, default: f64, zero_ok: bool| {
+            let field = format!("rail_support.discrete.{key}");
+            crate::track::support::checked(path, field, v.unwrap_or(default), zero_ok)
         };
         let kv = |k: &str, kd: Option<f64>, c: &str, cd: Option<f64>, def: KelvinVoigt| {
             Ok::<_, Error>(KelvinVoigt {

@@ -48,12 +48,7 @@ pub fn receptance(
     let s = t.start() + (0.5 * p.bays as f64).floor() * p.spacing + offset;
     let n = (seconds / dt).round() as usize;
     // A unit impulse over the first step, then free vibration.
-    let strike = [0, 1].map(|side| Load {
-        side,
-        s,
-        lateral: 0.0,
-        vertical: 1.0 / dt,
-    });
+    let strike = Load::wheelset(s, 0.0, 1.0 / dt);
     let mut x: Vec<Complex64> = Vec::with_capacity(n);
     t.step(dt, &strike);
     x.push(Complex64::new(t.rail(0, s)[2], 0.0));

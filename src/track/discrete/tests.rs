@@ -3,14 +3,9 @@
 
 use super::*;
 
-/// Both rails loaded alike at `s` (a wheelset's two wheels), `p` N down each.
+/// A wheelset's two wheels at `s`, `p` N down each.
 fn pair(s: f64, p: f64) -> [Load; 2] {
-    [0, 1].map(|side| Load {
-        side,
-        s,
-        lateral: 0.0,
-        vertical: -p,
-    })
+    Load::wheelset(s, 0.0, -p)
 }
 
 fn settled(p: DiscreteSupport, centre: f64, loads: &[Load]) -> TrackDynamics {
@@ -140,12 +135,7 @@ fn moving_load_below_critical_speed_carries_its_basin() {
 fn released_track_comes_to_rest_at_the_default_step() {
     let p = DiscreteSupport::default();
     let mut t = settled(p, 12.0, &pair(12.0, 150e3));
-    let lateral = [0, 1].map(|side| Load {
-        side,
-        s: 12.0,
-        lateral: 40e3,
-        vertical: 0.0,
-    });
+    let lateral = Load::wheelset(12.0, 40e3, 0.0);
     t.settle(5e-4, 0.5, &lateral);
     let dt = 1.0 / 1200.0;
     let mut peak = [0.0f64; 2];
