@@ -341,6 +341,14 @@ fn headline(out: &Path) -> Result<Table> {
         }
     }
     if let Some(t) = find(&tables("mismatch")?, "mismatch") {
+        // The part reads its own window (the other parts' protocol above says 20).
+        let window = read_json(&out.join("mismatch/meta.json")).map_or(String::new(), |m| {
+            let label = m["label_at"].as_str().unwrap_or("?").to_lowercase();
+            m["mismatch_window"].as_u64().map_or(String::new(), |w| {
+                let seconds = w as f64 / crate::sensors::RATE_HZ;
+                format!("; windows of {w} steps ({seconds} s), label at the {label} step")
+            })
+        });
         // The deployable models: fleet-trained with the weighed mass, on the fleet's test wagons.
         for r in &t.rows {
             if cell(&t, r, "tested on") == "fleet" && cell(&t, r, "inputs").contains("mass") {
@@ -352,7 +360,7 @@ fn headline(out: &Path) -> Result<Table> {
                         cell(&t, r, "inputs"),
                         cell(&t, r, "trained on")
                     ),
-                    "the fleet's wagons drawn for the test seeds".into(),
+                    format!("the fleet's wagons drawn for the test seeds{window}"),
                 ));
             }
         }
