@@ -1,7 +1,7 @@
 //! The documents as a reader meets them: every relative link and anchor resolves, no dated or
 //! relative-time phrase outside CHANGELOG.md and the results snapshot, every `railforce …`
 //! command they quote parses, the README quotes the snapshot's headline table, the channel
-//! table is the recorder's, and the label position is one default in every front end.
+//! table is the recorder's, every repository file they quote exists, and the label position is one default in every front end.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -45,6 +45,67 @@ fn markdown_files() -> Vec<PathBuf> {
     walk(&root(), true, &ignored, &mut out);
     out.sort();
     out
+}
+
+/// The spans a Markdown line quotes in backticks.
+fn quoted_spans(line: &str) -> Vec<&str> {
+    line.split('`').skip(1).step_by(2).collect()
+}
+
+/// A quoted span that names one file the repository carries: a path under a tracked top-level
+/// folder, with an extension, and nothing a reader fills in (`<…>`, `*`, `{…}`, `NAME`, spaces).
+fn repository_path(span: &str) -> Option<&str> {
+    const TRACKED: [&str; 9] = [
+        "examples/",
+        "src/",
+        "tests/",
+        "vehicles/",
+        "tracks/",
+        "python/",
+        "assets/",
+        "benches/",
+        ".ci/",
+    ];
+    let span = span.trim();
+    let plain = !span.contains(|c: char| c.is_whitespace() || "<>*{}[]$:".contains(c))
+        && !["NAME", "FILE", "DIR"].iter().any(|p| span.contains(p));
+    let file = span.rsplit('/').next().is_some_and(|n| n.contains('.'));
+    (plain && file && TRACKED.iter().any(|t| span.starts_with(t))).then_some(span)
+}
+
+#[test]
+fn every_repository_file_the_documents_quote_exists() {
+    let mut missing = Vec::new();
+    for f in markdown_files() {
+        let text = std::fs::read_to_string(&f).unwrap();
+        for (n, line) in prose_lines(&text) {
+            for span in quoted_spans(line) {
+                if let Some(path) = repository_path(span)
+                    && !root().join(path).exists()
+                {
+                    missing.push(format!("{}:{n}: `{path}`", rel(&f)));
+                }
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "quoted files that do not exist:\n{}",
+        missing.join("\n")
+    );
+}
+
+#[test]
+fn the_quoted_path_check_catches_what_it_should() {
+    assert_eq!(
+        repository_path("examples/python/train_windows.py"),
+        Some("examples/python/train_windows.py")
+    );
+    assert_eq!(repository_path("src/track/"), None);
+    assert_eq!(repository_path("vehicles/<name>.toml"), None);
+    assert_eq!(repository_path("vehicles/NAME.consist.toml"), None);
+    assert_eq!(repository_path("railforce simulate"), None);
+    assert!(quoted_spans("see `a/b.rs` and `c`").contains(&"a/b.rs"));
 }
 
 /// The path from the project's root, with `/` between its parts on every platform.
