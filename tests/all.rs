@@ -50,6 +50,8 @@ mod rails_on_sleepers;
 mod sensitivity;
 #[path = "sensors.rs"]
 mod sensors;
+#[path = "short_waves.rs"]
+mod short_waves;
 #[path = "sklearn.rs"]
 mod sklearn;
 #[path = "stability.rs"]

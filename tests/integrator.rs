@@ -4,7 +4,8 @@
 //! Wickens' critical speed, the statistics of the fine step and a steady curve's load
 //! transfer at their own default steps.
 
-use railforce::sim::fidelity::{self, StepDifference, StepStudy};
+use railforce::sim::fidelity;
+use railforce::sim::step_study::{self, StepDifference, StepStudy};
 use railforce::sim::{Integrator, SimConfig};
 use railforce::track::{Track, TrackSpec};
 use railforce::vehicle::Vehicle;
@@ -41,7 +42,7 @@ fn heun_step_is_second_order_and_the_semi_implicit_first() {
     let v = Vehicle::load(&root().join("vehicles/restrained_wheelset.toml")).unwrap();
     let track = rigid_tangent();
     let study = |integrator| {
-        fidelity::step_study(
+        step_study::step_study(
             &v,
             &track,
             80.0 / 3.6,
@@ -71,7 +72,7 @@ fn heun_step_is_second_order_and_the_semi_implicit_first() {
 #[ignore = "long simulation: run in release"]
 fn the_c80_converges_at_second_order_with_heuns_step() {
     let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
-    let s = fidelity::step_study(
+    let s = step_study::step_study(
         &v,
         &rigid_tangent(),
         80.0 / 3.6,
@@ -140,7 +141,7 @@ fn linearly_implicit_steps_keep_the_statistics() {
         ] {
             let dt = integrator.default_step();
             let study = |integrator| {
-                fidelity::step_study(
+                step_study::step_study(
                     v,
                     &track,
                     kmh / 3.6,
@@ -153,7 +154,7 @@ fn linearly_implicit_steps_keep_the_statistics() {
             };
             let new = study(integrator);
             let d = new.trials[0].outcome.clone().unwrap();
-            let stats = |d: &fidelity::StepDifference| [d.yq_rms, d.q_sd, d.label_y_sd];
+            let stats = |d: &StepDifference| [d.yq_rms, d.q_sd, d.label_y_sd];
             // Measured over 20 s at 0.5 ms: at most 0.11 % (40 km/h), 0.27 % (R 400 m,
             // 80 km/h); 60 s at 5/6 ms with the Hertz spring: assets/docs/physics.md §6.
             let limit = 0.01;

@@ -22,7 +22,7 @@ fn smooth_r400(model: &str) -> TrackSpec {
 /// Mean Q and Y of every wheel over `seconds` in the body of the curve at 60 km/h.
 fn curve_means(spec: TrackSpec, seconds: f64) -> Vec<(f64, f64)> {
     let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
-    let dt = Stepping::default().step_on(&spec);
+    let dt = Stepping::default().step_on(&spec, &v, 60.0 / 3.6).unwrap();
     let track = Track::new(spec, None);
     let cfg = SimConfig {
         speed: 60.0 / 3.6,
@@ -101,11 +101,12 @@ fn runs_on_sleepers_repeat_bit_for_bit() {
 #[test]
 fn the_step_on_sleepers_and_what_is_refused() {
     let spec = smooth_r400("discrete");
-    assert_eq!(Stepping::default().step_on(&spec), MAX_STEP_ON_BEAMS);
-    assert_eq!(Stepping::chosen(None, Some(1e-4)).step_on(&spec), 1e-4);
-    let lumped = smooth_r400("lumped");
-    assert_eq!(Stepping::default().step_on(&lumped), Stepping::default().dt);
     let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
+    let step = |s: &Stepping, spec: &TrackSpec| s.step_on(spec, &v, 20.0).unwrap();
+    assert_eq!(step(&Stepping::default(), &spec), MAX_STEP_ON_BEAMS);
+    assert_eq!(step(&Stepping::chosen(None, Some(1e-4)), &spec), 1e-4);
+    let lumped = smooth_r400("lumped");
+    assert_eq!(step(&Stepping::default(), &lumped), Stepping::default().dt);
     let track = Track::new(spec, None);
     for integrator in [Integrator::LinearlyImplicit, Integrator::SemiImplicit] {
         let cfg = SimConfig {

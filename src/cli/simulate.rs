@@ -99,7 +99,9 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     }
     let track = Track::new(spec, args.seed);
     let mut cfg = cfg;
-    cfg.dt = request.stepping.step_on(track.spec());
+    cfg.dt = request
+        .stepping
+        .step_on(track.spec(), &vehicle, cfg.speed)?;
     let dt = cfg.dt;
     cfg.train = railforce::sim::hitch::TrainSetup::resolve(
         &args.consist,

@@ -421,7 +421,7 @@ pub fn generate(
             // One set of channels in a data set: every run records the couplers when any
             // condition runs in a train.
             coupler_channels: plan.conditions.iter().any(|c| c.train.is_some()),
-            dt: opts.stepping.step_on(spec),
+            dt: opts.stepping.step_on(spec, vehicle, speed_kmh / 3.6)?,
             integrator: opts.stepping.integrator,
             // A derailment risk (Nadal's limit held 50 ms) is reported and the run kept: a
             // data set wants those forces; a flange climb still stops the run.

@@ -117,7 +117,7 @@ fn simulate<'py>(
                 spec.set_rail_model(m)?;
             }
             let mut cfg = cfg;
-            cfg.dt = request.stepping.step_on(&spec);
+            cfg.dt = request.stepping.step_on(&spec, &vehicle, cfg.speed)?;
             let track = Track::new(spec, seed);
             let mut sim = Simulation::new(&vehicle, &track, cfg)?;
             output::record(&mut sim, |_| {})

@@ -174,16 +174,87 @@ impl PartialEq for Stepping {
     }
 }
 
+/// The longest step a run over short waves takes (rail roughness, weld dips:
+/// [`crate::track::short_wave`]), 80 per 5 ms sample. The engine's error in the label
+/// wheel's FQ falls with the step's first power in the 20–50 and 50–100 Hz bands that short
+/// waves excite: against a step ten times finer, 5/6 ms reads them 6 % and 22 % off on a
+/// CNOSSOS-rough tangent at 100 km/h, 0.1 ms 0.8 % and 3.6 %, this step within 3 % (physics.md
+/// §3.4; `railforce bench step` on such a track).
+pub const MAX_STEP_SHORT_WAVES: f64 = 6.25e-5;
+
+/// Steps per period of the shortest wave's passing frequency `V/λ` at least, so a wave
+/// shorter than the default 0.1 m is followed too (ω·Δt ≤ 2π/20).
+pub const STEPS_PER_SHORTEST_WAVE: f64 = 20.0;
+
+/// The output's sample interval the steps divide, s (200 Hz).
+const SAMPLE_INTERVAL: f64 = 5e-3;
+
 impl Stepping {
-    /// The step a run on the track `spec` takes: the given step, else the integrator's own,
-    /// at most [`MAX_STEP_ON_BEAMS`] on rails on sleepers (a whole fraction of the 5 ms
-    /// sample).
-    pub fn step_on(&self, spec: &crate::track::TrackSpec) -> f64 {
-        if self.given || spec.discrete_rails.is_none() || self.dt <= MAX_STEP_ON_BEAMS {
-            self.dt
-        } else {
-            MAX_STEP_ON_BEAMS
+    /// The longest step a run of `vehicle` on the track `spec` at `speed` (m/s) may take and
+    /// why: at most [`MAX_STEP_ON_BEAMS`] on rails on sleepers; over short waves (the track's
+    /// roughness and welds, the wheels' flats and polygons) at most [`MAX_STEP_SHORT_WAVES`]
+    /// and [`STEPS_PER_SHORTEST_WAVE`] steps per passing of the shortest wave, a whole fraction
+    /// of the 5 ms sample. None on any other run.
+    pub fn limit_on(
+        spec: &crate::track::TrackSpec,
+        vehicle: &crate::vehicle::Vehicle,
+        speed: f64,
+    ) -> Option<(f64, String)> {
+        let mut limit: Option<(f64, String)> = spec.discrete_rails.map(|_| {
+            (
+                MAX_STEP_ON_BEAMS,
+                "rails on sleepers are followed at 0.25 ms".to_string(),
+            )
+        });
+        let track = spec.short_waves.map(|w| w.shortest_wavelength());
+        let wheels = vehicle.shortest_wave();
+        if track.is_some() || wheels.is_some() {
+            let lambda = track
+                .unwrap_or(f64::INFINITY)
+                .min(wheels.unwrap_or(f64::INFINITY));
+            let f = speed.abs() / lambda;
+            let wanted = MAX_STEP_SHORT_WAVES.min(1.0 / (STEPS_PER_SHORTEST_WAVE * f.max(1e-9)));
+            let dt = SAMPLE_INTERVAL / (SAMPLE_INTERVAL / wanted).ceil();
+            if limit.as_ref().is_none_or(|(l, _)| dt < *l) {
+                limit = Some((
+                    dt,
+                    format!(
+                        "short waves (down to {:.0} mm, {f:.0} Hz at {:.0} km/h) excite FQ up to 100 Hz and beyond, which a step of at most {:.4} ms follows",
+                        lambda * 1e3,
+                        speed * 3.6,
+                        dt * 1e3
+                    ),
+                ));
+            }
         }
+        limit
+    }
+
+    /// The step a run of `vehicle` on the track `spec` at `speed` (m/s) takes: the
+    /// integrator's own, at most [`Stepping::limit_on`]'s; a given step as given, refused where
+    /// short waves need a finer one (a run never reads their bands silently wrong).
+    pub fn step_on(
+        &self,
+        spec: &crate::track::TrackSpec,
+        vehicle: &crate::vehicle::Vehicle,
+        speed: f64,
+    ) -> crate::error::Result<f64> {
+        let Some((limit, why)) = Self::limit_on(spec, vehicle, speed) else {
+            return Ok(self.dt);
+        };
+        if !self.given {
+            return Ok(self.dt.min(limit));
+        }
+        let short = spec.short_waves.is_some() || vehicle.shortest_wave().is_some();
+        if short && self.dt > limit * (1.0 + 1e-9) {
+            return Err(crate::error::Error::Domain(format!(
+                "a step of {:.4} ms is too coarse for {} on track '{}': {why}; give at most that step, or none",
+                self.dt * 1e3,
+                vehicle.name,
+                spec.name
+            )));
+        }
+        Ok(self.dt)
     }
 
     /// The integrator named (checked against [`Integrator::NAMES`]; the default where none or

@@ -26,12 +26,15 @@ pub mod output;
 pub mod profile;
 mod rail_beams;
 mod request;
+pub mod step_study;
 mod track_frame;
 mod watch;
 mod wheel_rail;
 mod wheelset_solve;
 
-pub use integrator::{Integrator, MAX_STEP_ON_BEAMS, Stepping};
+pub use integrator::{
+    Integrator, MAX_STEP_ON_BEAMS, MAX_STEP_SHORT_WAVES, STEPS_PER_SHORTEST_WAVE, Stepping,
+};
 pub use output::{Recorder, RunSummary};
 pub use request::RunRequest;
 pub use track_frame::{TrackFrame, project};

@@ -74,7 +74,18 @@ impl Simulation<'_> {
             ),
         ];
         let wheels = std::array::from_fn(|k| {
-            let (side, irr_y, irr_z, y_ds, z_ds) = sides[k];
+            let (side, irr_y, mut irr_z, y_ds, mut z_ds) = sides[k];
+            // An out-of-round wheel: its radius's shortfall lowers it as the rail would.
+            for d in self
+                .vehicle
+                .wheel_defects
+                .iter()
+                .filter(|d| d.wheel == 2 * w + k)
+            {
+                let (dr, rate) = d.radius_change(f.point.s);
+                irr_z += dr;
+                z_ds += rate;
+            }
             let rail = self.rails[2 * w + k];
             WheelOnRail {
                 side,

@@ -33,6 +33,8 @@ struct TrackFile {
     profile: Option<ProfileFile>,
     irregularity: Option<IrregularityFile>,
     rail_support: Option<super::support::RailSupportFile>,
+    roughness: Option<super::short_wave::RoughnessFile>,
+    welds: Option<super::short_wave::WeldsFile>,
 }
 
 fn default_rail_spacing() -> f64 {
@@ -136,6 +138,8 @@ pub struct TrackSpec {
     /// Rails as beams on discrete sleepers (`[rail_support] model = "discrete"`); None
     /// otherwise. At most one of the two is set ([`TrackSpec::set_rail_model`]).
     pub discrete_rails: Option<super::discrete::DiscreteSupport>,
+    /// Rail roughness and weld dips (`[roughness]`, `[welds]`), if any.
+    pub short_waves: Option<super::short_wave::ShortWaveSpec>,
 }
 
 /// The rails' supports a run can choose by name ([`TrackSpec::set_rail_model`]).
@@ -441,6 +445,14 @@ impl TrackSpec {
             }
         };
 
+        let short_waves = super::short_wave::from_file(
+            path,
+            raw.roughness.as_ref(),
+            raw.welds.as_ref(),
+            length,
+            irregularity.map(|i| (i.min_wavelength, i.seed, i.smooth_start, i.fade_in)),
+        )?;
+
         Ok(TrackSpec {
             source: path.to_path_buf(),
             name: raw.name.unwrap_or_else(|| {
@@ -456,6 +468,7 @@ impl TrackSpec {
             irregularity,
             rail_support,
             discrete_rails,
+            short_waves,
         })
     }
 

@@ -14,6 +14,8 @@ use rand_distr::{Distribution, Uniform};
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex64;
 
+pub(super) use crate::dsp::catmull_rom;
+
 /// FRA PSD constant k (all classes).
 const FRA_K: f64 = 0.25;
 /// 1 cm² = 1e-4 m².
@@ -329,39 +331,27 @@ impl Irregularities {
         // 16 points per shortest wavelength keeps cubic interpolation error below 0.1 %.
         let dx = spec.min_wavelength / 16.0;
         let n_pts = crate::bounds::to_count((length / dx).ceil()) + 6;
-        let n_fft = (2 * n_pts).next_power_of_two();
-        let d_omega = 2.0 * PI / (n_fft as f64 * dx);
-        let (w_lo, w_hi) = (
+        let band = (
             2.0 * PI / spec.max_wavelength,
             2.0 * PI / spec.min_wavelength,
         );
-        let k_lo = crate::bounds::to_count((w_lo / d_omega).ceil().max(1.0));
-        let k_hi = crate::bounds::to_count((w_hi / d_omega).floor()).min(n_fft / 2 - 1);
         let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
-        let phase = Uniform::new(0.0, 2.0 * PI).expect("valid range");
-        let fft = FftPlanner::<f64>::new().plan_fft_inverse(n_fft);
         let mut gauge_raw = [0.0; 3];
         let samples = Channel::ALL.map(|ch| {
-            let mut buf = vec![Complex64::new(0.0, 0.0); n_fft];
-            for (k, b) in buf.iter_mut().enumerate().take(k_hi + 1).skip(k_lo) {
-                let amp = (2.0 * spec.psd(ch, k as f64 * d_omega) * d_omega).sqrt();
-                *b = Complex64::from_polar(amp, phase.sample(&mut rng));
-            }
-            fft.process(&mut buf);
-            buf.truncate(n_pts);
+            let raw = sum_of_cosines(n_pts, dx, band, |w| spec.psd(ch, w), &mut rng);
             let (lo, hi) = spec.gauge_limits;
             if ch == Channel::Gauge {
-                let n = buf.len() as f64;
+                let n = raw.len() as f64;
                 gauge_raw = [
-                    buf.iter().map(|c| c.re).fold(f64::INFINITY, f64::min),
-                    buf.iter().map(|c| c.re).fold(f64::NEG_INFINITY, f64::max),
-                    (buf.iter().map(|c| c.re * c.re).sum::<f64>() / n).sqrt(),
+                    raw.iter().copied().fold(f64::INFINITY, f64::min),
+                    raw.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    (raw.iter().map(|v| v * v).sum::<f64>() / n).sqrt(),
                 ];
             }
-            buf.into_iter()
-                .map(|c| match ch {
-                    Channel::Gauge => soft_limit(c.re, lo, hi),
-                    _ => c.re,
+            raw.into_iter()
+                .map(|v| match ch {
+                    Channel::Gauge => soft_limit(v, lo, hi),
+                    _ => v,
                 })
                 .collect()
         });
@@ -409,43 +399,18 @@ impl Irregularities {
     /// The grid interval of `s` and the fraction into it (every channel has the same grid).
     #[inline]
     fn locate(&self, s: f64) -> (usize, f64) {
-        let n = self.samples[0].len();
-        // `max` before `min`: a NaN position lands on the grid's first interval instead of
-        // an index out of range (the run's own check names the divergence).
-        let u = ((s - self.origin) / self.dx).max(1.0).min((n - 3) as f64);
-        let i = crate::bounds::cell_clamped(u, n - 2);
-        (i, u - i as f64)
+        locate(self.origin, self.dx, self.samples[0].len(), s)
     }
 
     /// One channel's Catmull–Rom value and derivative in interval `i` at fraction `t`.
     #[inline]
     fn cubic(&self, ch: Channel, i: usize, t: f64) -> (f64, f64) {
-        let v = &self.samples[ch as usize];
-        let (p0, p1, p2, p3) = (v[i - 1], v[i], v[i + 1], v[i + 2]);
-        let a = 2.0 * p1;
-        let b = p2 - p0;
-        let c = 2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3;
-        let d = -p0 + 3.0 * p1 - 3.0 * p2 + p3;
-        let val = 0.5 * (a + t * (b + t * (c + t * d)));
-        let der = 0.5 * (b + t * (2.0 * c + 3.0 * t * d)) / self.dx;
-        (val, der)
+        catmull_rom(&self.samples[ch as usize], i, t, self.dx)
     }
 
-    /// Fade-in factor at `s` and its derivative: 0 on the smooth lead, then
-    /// `½(1 − cos(π·u/L))` over the fade-in length L (u measured from the end of the lead).
+    /// Fade-in factor at `s` and its derivative ([`fade`]).
     fn fade(&self, s: f64) -> (f64, f64) {
-        let l = self.spec.fade_in;
-        let s = s - self.spec.smooth_start;
-        if s <= 0.0 && (l > 0.0 || s < 0.0) {
-            (0.0, 0.0)
-        } else if l <= 0.0 || s >= l {
-            (1.0, 0.0)
-        } else if s <= 0.0 {
-            (0.0, 0.0)
-        } else {
-            let w = std::f64::consts::PI / l;
-            (0.5 * (1.0 - (w * s).cos()), 0.5 * w * (w * s).sin())
-        }
+        fade(s, self.spec.smooth_start, self.spec.fade_in)
     }
 
     /// Offsets of both rails at `s`: `z_L = z_v + z_c/2`, `z_R = z_v − z_c/2`,
@@ -483,5 +448,62 @@ impl Irregularities {
             right_y_ds: ya_d - 0.5 * yg_d,
             right_z_ds: zv_d - 0.5 * zc_d,
         }
+    }
+}
+
+/// `z(x) = Σ √(2·S(Ω_k)·ΔΩ)·cos(Ω_k·x + φ_k)` over the band `(Ω_lo, Ω_hi)` (rad/m) on `n_pts`
+/// points `dx` apart, by one inverse FFT on a grid at least twice as long (so nothing repeats
+/// along the track); `psd` is one-sided in m²/(rad/m), the phases are drawn from `rng` in
+/// order of rising Ω.
+pub(super) fn sum_of_cosines(
+    n_pts: usize,
+    dx: f64,
+    band: (f64, f64),
+    psd: impl Fn(f64) -> f64,
+    rng: &mut ChaCha8Rng,
+) -> Vec<f64> {
+    use std::f64::consts::PI;
+    let n_fft = (2 * n_pts).next_power_of_two();
+    let d_omega = 2.0 * PI / (n_fft as f64 * dx);
+    let k_lo = crate::bounds::to_count((band.0 / d_omega).ceil().max(1.0));
+    let k_hi = crate::bounds::to_count((band.1 / d_omega).floor()).min(n_fft / 2 - 1);
+    let phase = Uniform::new(0.0, 2.0 * PI).expect("valid range");
+    let mut buf = vec![Complex64::new(0.0, 0.0); n_fft];
+    for (k, b) in buf.iter_mut().enumerate().take(k_hi + 1).skip(k_lo) {
+        let amp = (2.0 * psd(k as f64 * d_omega) * d_omega).sqrt();
+        *b = Complex64::from_polar(amp, phase.sample(rng));
+    }
+    FftPlanner::<f64>::new()
+        .plan_fft_inverse(n_fft)
+        .process(&mut buf);
+    buf.truncate(n_pts);
+    buf.into_iter().map(|c| c.re).collect()
+}
+
+/// The interval of a grid (`n` samples from `origin`, `dx` apart) that holds `s`, and the
+/// fraction into it, kept where a Catmull–Rom cubic has its four points.
+#[inline]
+pub(super) fn locate(origin: f64, dx: f64, n: usize, s: f64) -> (usize, f64) {
+    // `max` before `min`: a NaN position lands on the grid's first interval instead of
+    // an index out of range (the run's own check names the divergence).
+    let u = ((s - origin) / dx).max(1.0).min((n - 3) as f64);
+    let i = crate::bounds::cell_clamped(u, n - 2);
+    (i, u - i as f64)
+}
+
+/// Fade-in factor at `s` and its derivative: 0 on the smooth lead of `smooth_start` metres,
+/// then `½(1 − cos(π·u/L))` over the fade-in length L (u measured from the end of the lead).
+pub(super) fn fade(s: f64, smooth_start: f64, fade_in: f64) -> (f64, f64) {
+    let l = fade_in;
+    let s = s - smooth_start;
+    if s <= 0.0 && (l > 0.0 || s < 0.0) {
+        (0.0, 0.0)
+    } else if l <= 0.0 || s >= l {
+        (1.0, 0.0)
+    } else if s <= 0.0 {
+        (0.0, 0.0)
+    } else {
+        let w = std::f64::consts::PI / l;
+        (0.5 * (1.0 - (w * s).cos()), 0.5 * w * (w * s).sin())
     }
 }

@@ -10,6 +10,7 @@ pub mod discrete;
 mod file;
 pub mod irregularity;
 mod profile;
+pub mod short_wave;
 mod support;
 
 pub use alignment::{Alignment, Section, SectionKind, Turn, cant_deficiency_acceleration};
@@ -57,6 +58,7 @@ pub struct Track {
     spec: TrackSpec,
     alignment: Alignment,
     irregularities: Option<Irregularities>,
+    short_waves: Option<short_wave::ShortWaves>,
 }
 
 impl Track {
@@ -65,19 +67,30 @@ impl Track {
         Ok(Self::new(TrackSpec::load(path)?, None))
     }
 
-    /// Builds a track; `seed` overrides the irregularity seed of the file.
+    /// Builds a track; `seed` overrides the irregularity seed of the file (and the
+    /// roughness's, which is drawn on its own stream of the same seed).
     pub fn new(mut spec: TrackSpec, seed: Option<u64>) -> Self {
         if let (Some(irr), Some(seed)) = (spec.irregularity.as_mut(), seed) {
             irr.seed = seed;
+        }
+        if let (Some(r), Some(seed)) = (
+            spec.short_waves.as_mut().and_then(|w| w.roughness.as_mut()),
+            seed,
+        ) {
+            r.seed = seed;
         }
         let alignment = Alignment::new(&spec.sections);
         let irregularities = spec
             .irregularity
             .map(|irr| Irregularities::synthesize(irr, spec.length()));
+        let short_waves = spec
+            .short_waves
+            .map(|w| short_wave::ShortWaves::synthesize(w, spec.length()));
         Track {
             spec,
             alignment,
             irregularities,
+            short_waves,
         }
     }
 
@@ -101,6 +114,11 @@ impl Track {
         self.irregularities.as_ref()
     }
 
+    /// Rail roughness and weld dips, if the track has them.
+    pub fn short_waves(&self) -> Option<&short_wave::ShortWaves> {
+        self.short_waves.as_ref()
+    }
+
     /// Everything the track says at `s` (clamped to the track).
     pub fn at(&self, s: f64) -> TrackPoint {
         let s = s.clamp(0.0, self.length());
@@ -117,12 +135,26 @@ impl Track {
             elevation,
             gradient,
             vertical_curvature,
-            rails: self
-                .irregularities
-                .as_ref()
-                .map(|irr| irr.rails_at(s))
-                .unwrap_or_default(),
+            rails: self.rails_at(s),
         }
+    }
+
+    /// The irregular offsets of both rails at `s`: the geometry's, and under each wheel's
+    /// running surface the short waves' heights.
+    fn rails_at(&self, s: f64) -> RailIrregularity {
+        let mut r = self
+            .irregularities
+            .as_ref()
+            .map(|irr| irr.rails_at(s))
+            .unwrap_or_default();
+        if let Some(w) = &self.short_waves {
+            let [zl, dl, zr, dr] = w.at(s);
+            r.left_z += zl;
+            r.left_z_ds += dl;
+            r.right_z += zr;
+            r.right_z_ds += dr;
+        }
+        r
     }
 
     /// Centre-line position `(x, y)`, heading and curvature at `s` only (cheaper than

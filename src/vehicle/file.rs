@@ -28,6 +28,8 @@ macro_rules! define_vehicle_file {
             hauling: Option<HaulingFile>,
             sensors: Option<SensorsFile>,
             accelerometers: Option<String>,
+            #[serde(default)]
+            wheel_defect: Vec<super::wheel_defect::WheelDefectFile>,
         }
 
         /// Binds every element table, kind by kind in registration order, each row named by
@@ -342,6 +344,8 @@ pub(super) fn load_edited(
         }
     };
 
+    let wheel_defects =
+        super::wheel_defect::bind(path, &raw.wheel_defect, c.nominal_radius_m, wheelsets.len())?;
     let mut vehicle = Vehicle {
         name: raw.name.unwrap_or_else(|| "vehicle".into()),
         source: path.to_path_buf(),
@@ -364,6 +368,7 @@ pub(super) fn load_edited(
         hauling,
         sensors,
         accelerometers,
+        wheel_defects,
     };
     vehicle.distribute_static_load(path)?;
     // Elements that read others' static state (wedges, their nest's compression).

@@ -8,8 +8,10 @@ pub mod elements;
 mod file;
 mod urdf;
 mod wheel;
+pub mod wheel_defect;
 
 pub use wheel::{parse_wheel, wheel_name};
+pub use wheel_defect::{Flat, WheelDefect};
 
 pub use body::{Attachment, Body, BodyState, Wrench};
 pub use elements::Element;
@@ -181,6 +183,8 @@ pub struct Vehicle {
     pub sensors: Option<SensorLayout>,
     /// What every recorded acceleration is.
     pub accelerometers: Accelerometers,
+    /// Out-of-round wheels (`[[wheel_defect]]`), none by default.
+    pub wheel_defects: Vec<WheelDefect>,
 }
 
 impl Vehicle {
@@ -193,6 +197,20 @@ impl Vehicle {
             k / 2 + 1,
             if k.is_multiple_of(2) { 'L' } else { 'R' }
         )
+    }
+
+    /// The shortest wave the wheels' out-of-roundness rolls onto the rail, m: half a flat's
+    /// length, half a polygon's period; None with round wheels.
+    pub fn shortest_wave(&self) -> Option<f64> {
+        let turn = 2.0 * std::f64::consts::PI * self.contact.geometry.nominal_radius;
+        self.wheel_defects
+            .iter()
+            .flat_map(|d| {
+                let flat = d.flat.map(|f| 0.5 * f.rounded.unwrap_or(f.length));
+                let polygon = d.polygon.map(|(n, _)| 0.5 * turn / n as f64);
+                flat.into_iter().chain(polygon)
+            })
+            .reduce(f64::min)
     }
 
     /// Total mass, kg.

@@ -208,7 +208,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             let stepping = railforce::sim::Stepping::chosen(integrator.as_deref(), dt);
             let base = railforce::sim::SimConfig {
                 integrator: stepping.integrator,
-                dt: stepping.step_on(tr.spec()),
+                dt: stepping.step_on(tr.spec(), &v, speed_kmh / 3.6)?,
                 ..default.clone()
             };
             if let Some(other) = against {
@@ -243,7 +243,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             let own = file_track.spec().rail_model();
             if tr.spec().rail_model() != own {
                 let file_cfg = railforce::sim::SimConfig {
-                    dt: stepping.step_on(file_track.spec()),
+                    dt: stepping.step_on(file_track.spec(), &v, speed_kmh / 3.6)?,
                     ..base.clone()
                 };
                 let r =

@@ -1,0 +1,307 @@
+//! Short waves on the rails' running surface, below the geometry's irregularities: rail
+//! roughness from a published spectrum (with the contact filter a single-point Hertz contact
+//! needs) and weld dips (assets/docs/physics.md §3.4). Both are vertical and each rail has its
+//! own roughness; both fade in with the irregularities, so a vehicle starts on smooth rails.
+//! The `[roughness]` and `[welds]` tables of a track file are read here.
+
+mod roughness;
+mod weld;
+
+pub use roughness::{BAND_WIDTH, RoughnessSpectrum, contact_filter_db};
+pub use weld::Welds;
+
+use super::irregularity::{catmull_rom, fade, locate, sum_of_cosines};
+use crate::error::{Error, Result};
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::SeedableRng;
+use serde::Deserialize;
+use std::f64::consts::PI;
+use std::path::Path;
+
+/// Grid points per shortest roughness wavelength (as the irregularities': cubic
+/// interpolation within 0.1 %).
+const POINTS_PER_WAVELENGTH: f64 = 16.0;
+/// Most roughness samples per rail.
+const MAX_SAMPLES: f64 = 4e6;
+/// Shortest roughness wavelength accepted, m (the contact filter's table ends at 3.15 mm).
+pub const SHORTEST_WAVELENGTH: f64 = 0.005;
+
+/// Roughness settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoughnessSpec {
+    /// The spectrum drawn from.
+    pub spectrum: RoughnessSpectrum,
+    /// Shortest wavelength synthesised, m.
+    pub min_wavelength: f64,
+    /// Longest wavelength synthesised, m (where the irregularities stop).
+    pub max_wavelength: f64,
+    /// Whether the contact filter shapes the spectrum.
+    pub contact_filter: bool,
+    /// Seed of the phases (the track's irregularity seed: a run's seed moves both).
+    pub seed: u64,
+}
+
+impl RoughnessSpec {
+    /// The one-sided PSD the rails are drawn from at Ω (rad/m), m²/(rad/m): the spectrum,
+    /// through the contact filter when it is on.
+    pub fn psd(&self, omega: f64) -> f64 {
+        let k = omega / (2.0 * PI);
+        let filter = if self.contact_filter {
+            10f64.powf(contact_filter_db(1.0 / k) / 10.0)
+        } else {
+            1.0
+        };
+        self.spectrum.psd_per_cycle(k) * filter / (2.0 * PI)
+    }
+}
+
+/// Everything short-wave a track file asks for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShortWaveSpec {
+    /// Rail roughness, if any.
+    pub roughness: Option<RoughnessSpec>,
+    /// Weld dips, if any.
+    pub welds: Option<Welds>,
+    /// Smooth lead and fade-in length, m (the irregularities').
+    pub smooth_start: f64,
+    /// See `smooth_start`.
+    pub fade_in: f64,
+}
+
+impl ShortWaveSpec {
+    /// The shortest wavelength the excitation holds, m: the roughness's, half a weld's dip.
+    pub fn shortest_wavelength(&self) -> f64 {
+        let r = self.roughness.map_or(f64::INFINITY, |r| r.min_wavelength);
+        let w = self.welds.map_or(f64::INFINITY, |w| 0.5 * w.length);
+        r.min(w)
+    }
+}
+
+/// Short waves synthesised along a track.
+#[derive(Debug, Clone)]
+pub struct ShortWaves {
+    spec: ShortWaveSpec,
+    dx: f64,
+    origin: f64,
+    /// Roughness of the left and right rail on the grid (empty without roughness).
+    rails: [Vec<f64>; 2],
+}
+
+impl ShortWaves {
+    /// Draws the roughness of both rails over `[0, length]` (independent phases, one stream
+    /// apart from the irregularities' on the same seed).
+    pub fn synthesize(spec: ShortWaveSpec, length: f64) -> Self {
+        let Some(r) = spec.roughness else {
+            return ShortWaves {
+                spec,
+                dx: 1.0,
+                origin: 0.0,
+                rails: [Vec::new(), Vec::new()],
+            };
+        };
+        let dx = r.min_wavelength / POINTS_PER_WAVELENGTH;
+        let n_pts = crate::bounds::to_count((length / dx).ceil()) + 6;
+        let band = (2.0 * PI / r.max_wavelength, 2.0 * PI / r.min_wavelength);
+        let mut rng = ChaCha8Rng::seed_from_u64(r.seed);
+        rng.set_stream(1);
+        let rails = [0, 1].map(|_| sum_of_cosines(n_pts, dx, band, |w| r.psd(w), &mut rng));
+        ShortWaves {
+            spec,
+            dx,
+            origin: -2.0 * dx,
+            rails,
+        }
+    }
+
+    /// The settings they were drawn with.
+    pub fn spec(&self) -> &ShortWaveSpec {
+        &self.spec
+    }
+
+    /// Grid spacing of the roughness samples, m.
+    pub fn grid_step(&self) -> f64 {
+        self.dx
+    }
+
+    /// Roughness samples of the left (0) or right (1) rail on the grid from `−2·grid_step()`
+    /// (without the welds and the fade-in; empty without roughness), m.
+    pub fn roughness_samples(&self, side: usize) -> &[f64] {
+        &self.rails[side]
+    }
+
+    /// Height of the left and right running surface and their gradients at `s`, faded in:
+    /// `(z_left, dz_left/ds, z_right, dz_right/ds)`, m and 1.
+    pub fn at(&self, s: f64) -> [f64; 4] {
+        let (f, df) = fade(s, self.spec.smooth_start, self.spec.fade_in);
+        if f == 0.0 && df == 0.0 {
+            return [0.0; 4];
+        }
+        let (wz, wd) = self.spec.welds.map_or((0.0, 0.0), |w| w.at(s));
+        let mut out = [0.0; 4];
+        for (side, v) in self.rails.iter().enumerate() {
+            let (mut z, mut d) = (wz, wd);
+            if !v.is_empty() {
+                let (i, t) = locate(self.origin, self.dx, v.len(), s);
+                let (rz, rd) = catmull_rom(v, i, t, self.dx);
+                z += rz;
+                d += rd;
+            }
+            out[2 * side] = f * z;
+            out[2 * side + 1] = f * d + df * z;
+        }
+        out
+    }
+}
+
+/// `[roughness]` in a track file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RoughnessFile {
+    spectrum: String,
+    min_wavelength_m: Option<f64>,
+    max_wavelength_m: Option<f64>,
+    contact_filter: Option<bool>,
+    seed: Option<u64>,
+}
+
+/// `[welds]` in a track file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct WeldsFile {
+    spacing_m: Option<f64>,
+    first_m: Option<f64>,
+    depth_mm: Option<f64>,
+    length_m: Option<f64>,
+}
+
+/// The shortest roughness wavelength unless the file gives one, m: 0.1 m reaches 278 Hz at
+/// 100 km/h and 167 Hz at 60 km/h, past the 100 Hz a 200 Hz record holds (a choice).
+pub const DEFAULT_MIN_WAVELENGTH: f64 = 0.1;
+/// Weld spacing unless given, m: the 100 m factory-welded rails of Chinese continuous welded
+/// track (an estimate: field welds join them every few hundred metres too).
+pub const DEFAULT_WELD_SPACING: f64 = 100.0;
+/// Weld dip depth unless given, m: the 0.3 mm versine over a 1 m straightedge that a
+/// conventional weld is accepted at (Esveld), taken as a dip in service (an estimate).
+pub const DEFAULT_WELD_DEPTH: f64 = 0.3e-3;
+/// Weld dip length unless given, m: the straightedge's 1 m base.
+pub const DEFAULT_WELD_LENGTH: f64 = 1.0;
+
+/// The short waves of a track file, every key checked; `geometry_min_wavelength` is where
+/// the irregularities stop (none: 1 m), `seed` their seed, `(smooth_start, fade_in)` their
+/// lead. None when the file has neither table.
+pub(super) fn from_file(
+    path: &Path,
+    roughness: Option<&RoughnessFile>,
+    welds: Option<&WeldsFile>,
+    length: f64,
+    geometry: Option<(f64, u64, f64, f64)>,
+) -> Result<Option<ShortWaveSpec>> {
+    if roughness.is_none() && welds.is_none() {
+        return Ok(None);
+    }
+    let err = |field: &str, msg: String| Error::config(path, field, msg);
+    let (geo_min, geo_seed, smooth_start, fade_in) = geometry.unwrap_or((1.0, 1, 20.0, 50.0));
+    let roughness = match roughness {
+        None => None,
+        Some(r) => {
+            let spectrum = RoughnessSpectrum::parse(&r.spectrum).ok_or_else(|| {
+                err(
+                    "roughness.spectrum",
+                    format!(
+                        "unknown spectrum \"{}\": use {}",
+                        r.spectrum,
+                        RoughnessSpectrum::NAMES.join(", ")
+                    ),
+                )
+            })?;
+            let min = r.min_wavelength_m.unwrap_or(DEFAULT_MIN_WAVELENGTH);
+            if !(min.is_finite() && (SHORTEST_WAVELENGTH..1.0).contains(&min)) {
+                return Err(err(
+                    "roughness.min_wavelength_m",
+                    format!("must be at least {SHORTEST_WAVELENGTH} m and below 1 m, got {min}"),
+                ));
+            }
+            let max = r.max_wavelength_m.unwrap_or(geo_min);
+            if !(max.is_finite() && max > min) {
+                return Err(err(
+                    "roughness.max_wavelength_m",
+                    format!("must be above min_wavelength_m ({min}), got {max}"),
+                ));
+            }
+            if max > geo_min * (1.0 + 1e-9) {
+                return Err(err(
+                    "roughness.max_wavelength_m",
+                    format!(
+                        "{max} m reaches into the irregularities, which start at {geo_min} m: wavelengths between would be counted twice"
+                    ),
+                ));
+            }
+            if length / (min / POINTS_PER_WAVELENGTH) > MAX_SAMPLES {
+                return Err(err(
+                    "roughness.min_wavelength_m",
+                    format!(
+                        "{min} m on a {length:.0} m track needs more than {MAX_SAMPLES:.0} samples per rail: use a longer shortest wavelength or a shorter track"
+                    ),
+                ));
+            }
+            Some(RoughnessSpec {
+                spectrum,
+                min_wavelength: min,
+                max_wavelength: max,
+                contact_filter: r.contact_filter.unwrap_or(true),
+                seed: r.seed.unwrap_or(geo_seed),
+            })
+        }
+    };
+    let welds = match welds {
+        None => None,
+        Some(w) => {
+            let spacing = w.spacing_m.unwrap_or(DEFAULT_WELD_SPACING);
+            let depth = w.depth_mm.map_or(DEFAULT_WELD_DEPTH, |d| d * 1e-3);
+            let len = w.length_m.unwrap_or(DEFAULT_WELD_LENGTH);
+            let first = w.first_m.unwrap_or(spacing);
+            if !(spacing.is_finite() && (1.0..=10_000.0).contains(&spacing)) {
+                return Err(err(
+                    "welds.spacing_m",
+                    format!("must be between 1 and 10000 m, got {spacing}"),
+                ));
+            }
+            if !(depth.is_finite() && depth > 0.0 && depth <= 5e-3) {
+                return Err(err(
+                    "welds.depth_mm",
+                    format!("must be above 0 and at most 5 mm, got {}", depth * 1e3),
+                ));
+            }
+            if !(len.is_finite() && len >= 0.05 && len <= 0.5 * spacing) {
+                return Err(err(
+                    "welds.length_m",
+                    format!(
+                        "must be between 0.05 m and half the spacing ({} m), got {len}",
+                        0.5 * spacing
+                    ),
+                ));
+            }
+            if !(first.is_finite() && first >= 0.0) {
+                return Err(err(
+                    "welds.first_m",
+                    format!("must be zero or positive, got {first}"),
+                ));
+            }
+            Some(Welds {
+                spacing,
+                first,
+                depth,
+                length: len,
+            })
+        }
+    };
+    Ok(Some(ShortWaveSpec {
+        roughness,
+        welds,
+        smooth_start,
+        fade_in,
+    }))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,152 @@
+use super::*;
+use rustfft::FftPlanner;
+use rustfft::num_complex::Complex64;
+
+fn spec(filter: bool) -> ShortWaveSpec {
+    ShortWaveSpec {
+        roughness: Some(RoughnessSpec {
+            spectrum: RoughnessSpectrum::Iso3095,
+            min_wavelength: 0.02,
+            max_wavelength: 1.0,
+            contact_filter: filter,
+            seed: 7,
+        }),
+        welds: None,
+        smooth_start: 0.0,
+        fade_in: 0.0,
+    }
+}
+
+/// One-third-octave band levels (dB re 1 µm) of samples `x` at spacing `dx`, by periodogram,
+/// at the band centres `λ` given.
+fn band_levels(x: &[f64], dx: f64, centres: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    let mut buf: Vec<Complex64> = x.iter().map(|&v| Complex64::new(v, 0.0)).collect();
+    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+    let dk = 1.0 / (n as f64 * dx);
+    centres
+        .iter()
+        .map(|&lambda| {
+            let kc = 1.0 / lambda;
+            let (lo, hi) = (kc * 10f64.powf(-0.05), kc * 10f64.powf(0.05));
+            let power: f64 = (1..n / 2)
+                .filter(|&i| (lo..hi).contains(&(i as f64 * dk)))
+                .map(|i| 2.0 * buf[i].norm_sqr() / (n * n) as f64)
+                .sum();
+            10.0 * (power / 1e-12).log10()
+        })
+        .collect()
+}
+
+#[test]
+fn the_drawn_rails_hold_the_spectrums_band_levels() {
+    let centres = [0.5, 0.25, 0.1, 0.05, 0.04];
+    for filter in [false, true] {
+        let w = ShortWaves::synthesize(spec(filter), 400.0);
+        for side in 0..2 {
+            let got = band_levels(w.roughness_samples(side), w.grid_step(), &centres);
+            for (&lambda, got) in centres.iter().zip(got) {
+                let f = if filter {
+                    contact_filter_db(lambda)
+                } else {
+                    0.0
+                };
+                let want = RoughnessSpectrum::Iso3095.level_db(lambda) + f;
+                assert!(
+                    (got - want).abs() < 1.0,
+                    "side {side}, filter {filter}, {lambda} m: {got:.2} dB against {want:.2}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_two_rails_are_drawn_apart_and_the_same_seed_draws_the_same() {
+    let a = ShortWaves::synthesize(spec(true), 200.0);
+    let b = ShortWaves::synthesize(spec(true), 200.0);
+    assert_eq!(a.roughness_samples(0), b.roughness_samples(0));
+    let (l, r) = (a.roughness_samples(0), a.roughness_samples(1));
+    let dot: f64 = l.iter().zip(r).map(|(x, y)| x * y).sum();
+    let norm = (l.iter().map(|x| x * x).sum::<f64>() * r.iter().map(|x| x * x).sum::<f64>()).sqrt();
+    assert!((dot / norm).abs() < 0.1, "correlation {}", dot / norm);
+}
+
+#[test]
+fn welds_and_roughness_add_fade_in_and_the_gradient_is_the_derivative() {
+    let mut s = spec(true);
+    s.welds = Some(Welds {
+        spacing: 30.0,
+        first: 30.0,
+        depth: 0.3e-3,
+        length: 1.0,
+    });
+    s.smooth_start = 10.0;
+    s.fade_in = 10.0;
+    let w = ShortWaves::synthesize(s, 200.0);
+    assert_eq!(w.at(5.0), [0.0; 4]);
+    let h = 1e-5;
+    for x in [15.0, 29.8, 30.0, 61.3] {
+        let [zl, dl, zr, dr] = w.at(x);
+        let (p, m) = (w.at(x + h), w.at(x - h));
+        assert!((dl - (p[0] - m[0]) / (2.0 * h)).abs() < 1e-6, "at {x}");
+        assert!((dr - (p[2] - m[2]) / (2.0 * h)).abs() < 1e-6, "at {x}");
+        assert!(zl.is_finite() && zr.is_finite());
+    }
+    // At a weld's centre the dip is 0.3 mm under the roughness alone.
+    let mut rough = s;
+    rough.welds = None;
+    let r = ShortWaves::synthesize(rough, 200.0);
+    assert!((w.at(60.0)[0] - r.at(60.0)[0] + 0.3e-3).abs() < 1e-12);
+}
+
+fn parse(extra: &str) -> Result<Option<ShortWaveSpec>> {
+    let text = format!("{extra}\n");
+    #[derive(Deserialize)]
+    struct T {
+        roughness: Option<RoughnessFile>,
+        welds: Option<WeldsFile>,
+    }
+    let t: T = toml::from_str(&text).unwrap();
+    from_file(
+        Path::new("t.toml"),
+        t.roughness.as_ref(),
+        t.welds.as_ref(),
+        2000.0,
+        Some((1.0, 3, 20.0, 50.0)),
+    )
+}
+
+#[test]
+fn a_track_files_tables_are_read_with_their_defaults_and_bad_keys_refused() {
+    assert_eq!(parse("").unwrap(), None);
+    let s = parse("[roughness]\nspectrum = \"cnossos_m\"\n[welds]\n")
+        .unwrap()
+        .unwrap();
+    let r = s.roughness.unwrap();
+    assert_eq!(
+        (r.min_wavelength, r.max_wavelength, r.contact_filter, r.seed),
+        (0.1, 1.0, true, 3)
+    );
+    assert_eq!(s.welds.unwrap().spacing, 100.0);
+    assert_eq!(s.shortest_wavelength(), 0.1);
+    for (bad, field) in [
+        ("[roughness]\nspectrum = \"iso\"", "roughness.spectrum"),
+        (
+            "[roughness]\nspectrum = \"iso3095\"\nmin_wavelength_m = 0.001",
+            "roughness.min_wavelength_m",
+        ),
+        (
+            "[roughness]\nspectrum = \"iso3095\"\nmax_wavelength_m = 2.0",
+            "roughness.max_wavelength_m",
+        ),
+        ("[welds]\ndepth_mm = -0.1", "welds.depth_mm"),
+        (
+            "[welds]\nspacing_m = 10.0\nlength_m = 6.0",
+            "welds.length_m",
+        ),
+    ] {
+        let e = parse(bad).unwrap_err().to_string();
+        assert!(e.contains(field) && e.contains("t.toml"), "{bad}: {e}");
+    }
+}
