@@ -16,7 +16,8 @@ pub struct TrackArgs {
     #[arg(long, default_value_t = 0.25, value_name = "M")]
     step: f64,
     /// Check the irregularities against the FRA PSD: print sample vs formula RMS per channel
-    /// and write the Welch PSD beside the formula to CSV.
+    /// and write the Welch PSD beside the formula to CSV; the rails' roughness, where the file
+    /// has it, by third-octave band against its spectrum.
     #[arg(long)]
     psd: bool,
     /// Where `--psd` writes its CSV.
@@ -46,6 +47,7 @@ pub fn run(args: TrackArgs) -> Result<()> {
         println!("wrote {} (every {} m)", out.display(), args.step);
     }
     if args.psd {
+        print_roughness(&track);
         let irr = track.irregularities().with_context(|| {
             format!(
                 "{}: --psd needs an [irregularity] table in the track file",
@@ -174,15 +176,68 @@ fn print_summary(track: &Track) {
         ),
         None => println!("  no irregularities (smooth track)"),
     }
+    if let Some(w) = &spec.short_waves {
+        if let Some(r) = w.roughness {
+            println!(
+                "  rail roughness: {}, wavelengths {}–{} m, contact filter {}",
+                r.spectrum.name(),
+                r.min_wavelength,
+                r.max_wavelength,
+                if r.contact_filter { "on" } else { "off" }
+            );
+        }
+        if let Some(d) = w.welds {
+            println!(
+                "  weld dips every {} m from {} m: {} mm over {} m (gradient {:.2} mrad)",
+                d.spacing,
+                d.first,
+                d.depth * 1e3,
+                d.length,
+                d.gradient() * 1e3
+            );
+        }
+    }
+}
+
+/// The rails' drawn roughness by third-octave band against its spectrum (1 dB); the count of
+/// bands outside.
+fn print_roughness(track: &Track) -> usize {
+    let Some(w) = track.short_waves() else {
+        return 0;
+    };
+    let bands = check::roughness_bands(w, track.length());
+    if bands.is_empty() {
+        return 0;
+    }
+    println!("  drawn roughness by third-octave band against the spectrum (dB re 1 µm, ±1 dB):");
+    let mut misses = 0;
+    for b in &bands {
+        let ok = (b.drawn_db - b.expected_db).abs() <= 1.0;
+        misses += usize::from(!ok);
+        println!(
+            "  {} {} rail, {:>6.1} mm: {:>6.2} against {:>6.2}",
+            if ok { "pass" } else { "MISS" },
+            if b.side == 0 { "left " } else { "right" },
+            b.wavelength * 1e3,
+            b.drawn_db,
+            b.expected_db
+        );
+    }
+    misses
 }
 
 /// `railforce validate track`: the discrete track's checks (the file's parameters, else the
 /// default set), measured against expected; an error on a miss.
 pub fn validate_discrete(track: Option<&std::path::Path>) -> Result<()> {
+    let mut misses = 0;
     let p = match track {
         None => railforce::track::discrete::DiscreteSupport::default(),
         Some(t) => {
             let mut spec = TrackSpec::load(&super::builtin::resolve(t)?)?;
+            if spec.short_waves.is_some_and(|w| w.roughness.is_some()) {
+                println!("{}: rail roughness", spec.name);
+                misses += print_roughness(&Track::new(spec.clone(), None));
+            }
             spec.set_rail_model("discrete")?;
             spec.discrete_rails.context("set above")?
         }
@@ -193,7 +248,6 @@ pub fn validate_discrete(track: Option<&std::path::Path>) -> Result<()> {
         p.spacing,
         p.beta()
     );
-    let mut misses = 0;
     for c in railforce::track::discrete::checks(&p) {
         let ok = c.passes();
         misses += usize::from(!ok);

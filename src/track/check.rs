@@ -1,5 +1,6 @@
 //! Checks of synthesised irregularities against their PSD: sample RMS against the band RMS of
-//! the formula, and Welch's PSD estimate against the formula across the band.
+//! the formula, and Welch's PSD estimate against the formula across the band; the rails'
+//! roughness by third-octave band against the spectrum it was drawn from.
 
 use super::irregularity::{Channel, Irregularities};
 use crate::dsp::welch_psd;
@@ -153,4 +154,69 @@ pub struct OctaveRatio {
     pub hi: f64,
     /// Ratio per channel (order of [`Channel::ALL`]).
     pub ratio: [f64; 4],
+}
+
+/// One third-octave band of a rail's drawn roughness beside the level it was drawn from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BandLevel {
+    /// The band's centre wavelength, m.
+    pub wavelength: f64,
+    /// The left (0) or right (1) rail.
+    pub side: usize,
+    /// The drawn samples' level by periodogram over the track, dB re 1 µm.
+    pub drawn_db: f64,
+    /// The spectrum's level through the contact filter (when on), dB re 1 µm.
+    pub expected_db: f64,
+}
+
+/// The roughness of both rails by third-octave band, every band whose centre lies inside the
+/// drawn wavelengths by at least a third of an octave, against the spectrum it was drawn from.
+/// Empty without roughness.
+pub fn roughness_bands(w: &super::short_wave::ShortWaves, length: f64) -> Vec<BandLevel> {
+    use rustfft::FftPlanner;
+    use rustfft::num_complex::Complex64;
+    let Some(r) = w.spec().roughness else {
+        return Vec::new();
+    };
+    let dx = w.grid_step();
+    // Base-ten third octaves from 1 m down (n = 0, −1, … in k_c = 10^(n/10) cycles/m).
+    let centres: Vec<f64> = (0..40)
+        .map(|n| 10f64.powf(-(n as f64) / 10.0))
+        .filter(|l| {
+            *l <= r.max_wavelength * 10f64.powf(-0.1) && *l >= r.min_wavelength * 10f64.powf(0.1)
+        })
+        .collect();
+    let mut out = Vec::new();
+    for side in 0..2 {
+        let x = w.roughness_samples(side);
+        // The grid starts two steps before the track.
+        let first = 2;
+        let n = (crate::bounds::to_count((length / dx).floor())).min(x.len() - first);
+        let mut buf: Vec<Complex64> = x[first..first + n]
+            .iter()
+            .map(|&v| Complex64::new(v, 0.0))
+            .collect();
+        FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+        let dk = 1.0 / (n as f64 * dx);
+        for &lambda in &centres {
+            let kc = 1.0 / lambda;
+            let (lo, hi) = (kc * 10f64.powf(-0.05), kc * 10f64.powf(0.05));
+            let power: f64 = (1..n / 2)
+                .filter(|&i| (lo..hi).contains(&(i as f64 * dk)))
+                .map(|i| 2.0 * buf[i].norm_sqr() / (n * n) as f64)
+                .sum();
+            let filter = if r.contact_filter {
+                super::short_wave::contact_filter_db(lambda)
+            } else {
+                0.0
+            };
+            out.push(BandLevel {
+                wavelength: lambda,
+                side,
+                drawn_db: 10.0 * (power / 1e-12).log10(),
+                expected_db: r.spectrum.level_db(lambda) + filter,
+            });
+        }
+    }
+    out
 }
