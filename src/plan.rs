@@ -30,6 +30,9 @@ struct PlanFile {
     /// The rails' support of every condition that names none: `rigid`, `lumped` or
     /// `discrete` (absent: the track file's).
     rail_support: Option<String>,
+    /// Rail roughness of every condition that names none: `iso3095`, `cnossos_m` or `none`
+    /// (absent: the track file's).
+    roughness: Option<String>,
     #[serde(default)]
     condition: Vec<ConditionFile>,
 }
@@ -65,6 +68,7 @@ struct ConditionFile {
     turn: Option<String>,
     gauge_face: Option<String>,
     rail_support: Option<String>,
+    roughness: Option<String>,
     vary: Option<toml::Table>,
 }
 
@@ -205,6 +209,9 @@ pub struct Condition {
     /// The rails' support instead of the track file's (`rail_support = "rigid"`, `"lumped"`
     /// or `"discrete"`, [`crate::track::TrackSpec::set_rail_model`]; None: the file's).
     pub rail_support: Option<String>,
+    /// Rail roughness instead of the track file's (`roughness = "iso3095"`, `"cnossos_m"` or
+    /// `"none"`, [`crate::track::TrackSpec::set_roughness`]; None: the file's).
+    pub roughness: Option<String>,
 }
 
 impl Condition {
@@ -419,6 +426,24 @@ impl Plan {
                     format!("{m:?}: give one of {:?}", crate::track::RAIL_SUPPORT_MODELS),
                 ));
             }
+            let roughness = c.roughness.clone().or_else(|| raw.roughness.clone());
+            if let Some(r) = &roughness
+                && r != "none"
+                && crate::track::short_wave::RoughnessSpectrum::parse(r).is_none()
+            {
+                return Err(Error::config(
+                    path,
+                    if c.roughness.is_some() {
+                        f("roughness")
+                    } else {
+                        "roughness".into()
+                    },
+                    format!(
+                        "{r:?}: give \"none\" or one of {:?}",
+                        crate::track::short_wave::RoughnessSpectrum::NAMES
+                    ),
+                ));
+            }
             let train = match &consist {
                 Some(name) => crate::sim::hitch::TrainSetup::resolve(
                     name,
@@ -445,6 +470,7 @@ impl Plan {
                 order: conditions.len(),
                 flange_friction,
                 rail_support,
+                roughness,
             });
         }
         // Every file the plan names must be there now, not when its run comes up (checked last,

@@ -236,9 +236,33 @@ fn every_experiment_runs_end_to_end() {
         }
     }
     assert!(html.contains("fleet, ensemble of 2"));
+    // Model form: each track model's network on both tracks; the labels on both per condition.
+    let form = std::fs::read_to_string(out.join("model_form/model_form.csv")).unwrap();
+    assert!(
+        header("model_form/model_form.csv")
+            .starts_with("trained_on,tested_on,windows,fl_r2,fl_rmse_kn,fq_r2,fq_rmse_kn"),
+        "{form}"
+    );
+    assert_eq!(form.lines().count(), 1 + 4, "{form}");
+    assert!(
+        form.contains("lumped rail masses,rails on sleepers"),
+        "{form}"
+    );
+    assert!(
+        form.contains("rails on sleepers,lumped rail masses"),
+        "{form}"
+    );
+    let labels = std::fs::read_to_string(out.join("model_form/labels.csv")).unwrap();
+    assert_eq!(labels.lines().count(), 1 + 3, "{labels}");
+    let sleepers =
+        std::fs::read_to_string(out.join("model_form/data/on_sleepers/manifest.json")).unwrap();
+    assert!(sleepers.contains("discrete"), "the runs on sleepers say so");
+    // The lumped network is the generalisation part's, not trained again.
+    assert!(!out.join("model_form/models/lumped").exists());
+    assert!(html.contains("lumped track against rails on sleepers"));
     let data = meta["data_fnv1a"].clone();
 
-    // One part run again on its own into the same folder: the report still shows all six,
+    // One part run again on its own into the same folder: the report still shows all seven,
     // and the data identity is unchanged (nothing was regenerated).
     let again = ExperimentOptions {
         robustness_models: vec![ModelKind::Tree],
@@ -253,6 +277,7 @@ fn every_experiment_runs_end_to_end() {
         "protocols",
         "sensors",
         "mismatch",
+        "model_form",
     ] {
         assert!(
             html.contains(&format!("id=\"{part}\"")),

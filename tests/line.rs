@@ -386,3 +386,47 @@ fn a_plan_puts_its_runs_on_sleepers() {
     assert!(e.contains("rail_support") && e.contains("beams"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The plan key `roughness` (per plan, per condition, "none" to take it off) puts rail
+/// roughness on a condition's rails: on a smooth tangent the leading wheel's load then varies
+/// by more than 0.5 kN where it holds still without; the run's key records it; an unknown spectrum is refused by name.
+#[test]
+fn a_plan_puts_roughness_on_its_rails() {
+    let dir = temp("roughness");
+    let conditions = "[[condition]]\nname = \"c\"\ntrack = \"tangent.toml\"\nspeed_kmh = 60.0\nstart_m = 150.0\nseeds = [1]\n\
+         [[condition]]\nname = \"d\"\ntrack = \"tangent.toml\"\nspeed_kmh = 60.0\nstart_m = 150.0\nseeds = [1]\nroughness = \"none\"\n";
+    let p = plan(&dir, "roughness = \"cnossos_m\"", conditions);
+    assert_eq!(p.conditions[0].roughness.as_deref(), Some("cnossos_m"));
+    assert_eq!(p.conditions[1].roughness.as_deref(), Some("none"));
+    let out = dir.join("out");
+    let m = dataset::generate(&p, &opts(&out), &|_| {}).unwrap();
+    assert_eq!(m.runs.len(), 2);
+    let ds = DataSet::load(&out).unwrap();
+    let sd = |run: usize| {
+        let c = &ds.runs[run].columns[ds.channel("w1l_force_z").unwrap()];
+        let m = c.iter().sum::<f64>() / c.len() as f64;
+        (c.iter().map(|v| (v - m).powi(2)).sum::<f64>() / c.len() as f64).sqrt()
+    };
+    let (rough, smooth) = (sd(0), sd(1));
+    assert!(
+        rough > 500.0 && smooth < 0.1 * rough,
+        "{rough} N against {smooth} N"
+    );
+    let manifest = std::fs::read_to_string(out.join("manifest.json")).unwrap();
+    assert!(
+        manifest.contains("\"roughness\": \"cnossos_m\""),
+        "the manifest says so"
+    );
+    std::fs::write(
+        dir.join("bad.plan.toml"),
+        std::fs::read_to_string(dir.join("line.plan.toml"))
+            .unwrap()
+            .replace("\"cnossos_m\"", "\"rough\""),
+    )
+    .unwrap();
+    let e = Plan::load(&dir.join("bad.plan.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("roughness") && e.contains("rough"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

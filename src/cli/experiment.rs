@@ -27,9 +27,13 @@ pub enum WhichArg {
     /// selection) against the same trained on a fleet (--fleet), on the fleet's held-out
     /// wagons and four named extremes (half payload, wet rail, highest conicity, class 4).
     Mismatch,
+    /// The simulator's form: the CNN-BiLSTM (paper's 21) trained on the lumped track and
+    /// tested on rails on sleepers (every run simulated again on them), and the other way
+    /// round; the labels' spread on both tracks per condition.
+    ModelForm,
     /// The paper's three: comparison, generalization, robustness.
     Paper,
-    /// All six.
+    /// All seven.
     All,
     /// Run nothing: rewrite the results snapshot of the finished run in --out into
     /// --results (and the headline table --readme quotes).
@@ -165,6 +169,7 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
             WhichArg::Protocols => Which::Protocols,
             WhichArg::Sensors => Which::Sensors,
             WhichArg::Mismatch => Which::Mismatch,
+            WhichArg::ModelForm => Which::ModelForm,
             WhichArg::Paper => Which::Paper,
             WhichArg::All | WhichArg::Snapshot => Which::All,
         })

@@ -32,6 +32,11 @@ pub struct SimulateArgs {
     /// the step's cost, the default integrator only).
     #[arg(long, value_parser = railforce::track::RAIL_SUPPORT_MODELS)]
     rail_support: Option<String>,
+    /// Rail roughness below the irregularities, over the track file's `[roughness]`:
+    /// `iso3095` (EN ISO 3095's limit, ground rail), `cnossos_m` (an average network) or
+    /// `none`; down to 0.1 m through the contact filter. The step then follows it (62.5 µs).
+    #[arg(long, value_parser = ["iso3095", "cnossos_m", "none"])]
+    roughness: Option<String>,
     /// Output file, its format by its extension: `.csv`, `.parquet` (what `generate` writes) or
     /// `.npz`; a `.meta.json` file is written beside it.
     #[arg(long, default_value = "run.csv")]
@@ -97,6 +102,9 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     if let Some(m) = &args.rail_support {
         spec.set_rail_model(m)?;
     }
+    if let Some(r) = &args.roughness {
+        spec.set_roughness(r)?;
+    }
     let track = Track::new(spec, args.seed);
     let mut cfg = cfg;
     cfg.dt = request
@@ -125,7 +133,7 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         "train": train_meta,
         "tool": format!("railforce {}", env!("CARGO_PKG_VERSION")),
         "vehicle": {"file": args.vehicle, "hash_fnv1a": railforce::dataset::file_hash(&args.vehicle)?, "name": vehicle.name},
-        "track": {"file": args.track, "hash_fnv1a": railforce::dataset::file_hash(&args.track)?, "name": track.spec().name, "rail_support": track.spec().rail_model()},
+        "track": {"file": args.track, "hash_fnv1a": railforce::dataset::file_hash(&args.track)?, "name": track.spec().name, "rail_support": track.spec().rail_model(), "roughness": track.spec().short_waves.and_then(|w| w.roughness).map(|r| r.spectrum.name())},
         "seed": track.irregularities().map(|i| i.spec().seed),
         "speed_kmh": args.speed_kmh,
         "duration_s": args.duration,

@@ -167,6 +167,13 @@ pub struct RunEntry {
     /// `turn`; absent: as drawn).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub mirrored: bool,
+    /// The rails' support the plan chose over the track file's (`rigid`, `lumped`,
+    /// `discrete`; absent: the file's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rail_support: Option<String>,
+    /// The rail roughness the plan chose over the track file's (absent: the file's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roughness: Option<String>,
     /// Rows written. (Format 3 manifests also held each run's wall time, read and
     /// dropped: a manifest holds only what shapes the data, so one plan gives one manifest's
     /// bytes whether one process, shards or workers made it.)
@@ -370,6 +377,9 @@ pub(super) fn run_key(
     }
     if let Some(m) = &run.condition.rail_support {
         extra += &format!("|rail_support={m}");
+    }
+    if let Some(r) = &run.condition.roughness {
+        extra += &format!("|roughness={r}");
     }
     if !draws.is_empty() {
         extra += &format!(

@@ -289,6 +289,15 @@ pub fn generate(
                 )
             })?;
         }
+        if let Some(name) = &r.condition.roughness {
+            spec.set_roughness(name).map_err(|e| {
+                Error::config(
+                    &plan.source,
+                    format!("condition {}.roughness", r.condition.name),
+                    e.to_string(),
+                )
+            })?;
+        }
         tracks.push(Prepared {
             spec,
             mirrored,
@@ -479,6 +488,8 @@ pub fn generate(
             consist: run.condition.consist.clone(),
             position: train.as_ref().and_then(|t| t.position),
             mirrored: *mirrored,
+            rail_support: run.condition.rail_support.clone(),
+            roughness: run.condition.roughness.clone(),
             rows: rec.rows.len(),
             peak_y_over_q: rec.summary.peak_y_over_q,
             draws: crate::vary::to_json(draws),

@@ -5,7 +5,7 @@
 //! `[vary]`), both scored on the same held-out wagons: the fleet's test-seed runs, whose draws
 //! no training or validation run shares, and four named extremes of the nominal wagon.
 
-use super::{Ctx, ExperimentOptions, FitJob, PAPER21, SELECTED, f4, sensors};
+use super::{Ctx, ExperimentOptions, FitJob, PAPER21, SELECTED, earlier, f4, sensors};
 use crate::dataset::DataSet;
 use crate::error::{Error, Result};
 use crate::features::{NoiseProtocol, Split};
@@ -17,7 +17,7 @@ use crate::report::svg::{BarChart, BarSeries, WIDTH};
 use crate::report::table::{MISSING, Table};
 use crate::sensors::{Candidates, VEHICLE_MASS};
 use crate::vary::Vary;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// The fleet-trained CNN-BiLSTM on the on-board selection and the weighed mass.
@@ -117,34 +117,6 @@ fn extreme(plan: &Plan, name: &str, table: &str, seeds: &[u64], drop: bool) -> R
     Ok(p)
 }
 
-/// The model an earlier run of the experiments left in `dir` (the generalisation's or the
-/// sensors' CNN-BiLSTM), when it was trained on the same data under the same protocol
-/// (`channels`, or its own) and calibrated with its envelope: reused, not trained again.
-fn earlier(ctx: &Ctx, dir: &Path, ds: &DataSet, channels: Option<&[String]>) -> Option<Model> {
-    let m = Model::load(dir).ok()?;
-    let channels = channels.map_or_else(|| m.meta.data.channels.clone(), |c| c.to_vec());
-    let mut spec = ctx
-        .spec_windowed(
-            ds,
-            &channels,
-            &ctx.labels(),
-            NoiseProtocol::Matched,
-            ctx.split.clone(),
-            ctx.opts.mismatch_window,
-        )
-        .ok()?;
-    // The noise the experiments train with (`ds` may be the clean data).
-    spec.noise_model = Some(ctx.opts.noise(ctx.opts.snr_db));
-    let same = m.meta.kind == ModelKind::CnnBiLstm
-        && m.meta.data == spec
-        && m.meta.data_identity["data_fnv1a"].as_str() == Some(ctx.data_hash.as_str())
-        && m.meta
-            .calibration
-            .as_ref()
-            .is_some_and(|c| !c.envelope.is_empty());
-    same.then_some(m)
-}
-
 /// One test set: name, what it is, its data (noisy inputs), which windows.
 struct TestSet {
     name: String,
@@ -191,7 +163,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let paper21_dir = opts.out.join("generalization/models/all_conditions");
     let earlier_selected = match &ctx.selected {
         Some(_) => None,
-        None => earlier(ctx, &selected_dir, &ctx.ds, None),
+        None => earlier(ctx, &selected_dir, &ctx.ds, None, opts.mismatch_window),
     };
     let selected = match (&ctx.selected, &earlier_selected) {
         (Some(s), _) => s.clone(),
@@ -340,7 +312,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         } else {
             &selected_dir
         };
-        let on_disk = || earlier(ctx, dir, nominal_ds, Some(ins)).map(|_| dir.clone());
+        let on_disk =
+            || earlier(ctx, dir, nominal_ds, Some(ins), opts.mismatch_window).map(|_| dir.clone());
         match ctx.trained.iter().find(|(k, _)| same_window && *k == key) {
             Some((_, d)) => reused.push(Some(d.clone())),
             None if on_disk().is_some() => {

@@ -1,7 +1,8 @@
 //! The paper's experiments on railforce data (assets/docs/learning.md §4), and two of ours: model
 //! comparison, generalisation over conditions (with leave-one-condition-out, which the paper
 //! never ran), robustness to noise under both noise protocols, the protocols side by side,
-//! on-board sensor selection, and wagons the models did not learn (mismatch). Defaults: the plan's seeds split by seed (independent test runs),
+//! on-board sensor selection, wagons the models did not learn (mismatch), and the simulator's
+//! form (lumped track against rails on sleepers). Defaults: the plan's seeds split by seed (independent test runs),
 //! 6 dB with σ from each channel's standard deviation, window 20 with the centre label, fresh
 //! training noise. Each writes Markdown and CSV tables, SVG figures and its part of
 //! `index.html`, with seeds, data identity, protocol, noise definition, label position,
@@ -14,6 +15,7 @@ use fit::FitJob;
 mod generalization;
 mod index;
 mod mismatch;
+mod model_form;
 mod paper;
 mod protocols;
 mod robustness;
@@ -54,9 +56,11 @@ pub enum Which {
     Sensors,
     /// Nominal against fleet-trained models on wagons they did not learn.
     Mismatch,
+    /// The CNN-BiLSTM trained on the lumped track and tested on rails on sleepers, and back.
+    ModelForm,
     /// The paper's three (comparison, generalisation, robustness): the demo.
     Paper,
-    /// All six.
+    /// All seven.
     All,
 }
 
@@ -72,6 +76,7 @@ impl Which {
                 Protocols,
                 Sensors,
                 Mismatch,
+                ModelForm,
             ],
             Paper => vec![Comparison, Generalization, Robustness],
             w => vec![w],
@@ -79,13 +84,14 @@ impl Which {
     }
 
     /// Every experiment's folder, in report order.
-    pub const FOLDERS: [&'static str; 6] = [
+    pub const FOLDERS: [&'static str; 7] = [
         "comparison",
         "generalization",
         "robustness",
         "protocols",
         "sensors",
         "mismatch",
+        "model_form",
     ];
 
     fn folder(self) -> &'static str {
@@ -96,6 +102,7 @@ impl Which {
             Which::Protocols => "protocols",
             Which::Sensors => "sensors",
             Which::Mismatch => "mismatch",
+            Which::ModelForm => "model_form",
             _ => "all",
         }
     }
@@ -332,6 +339,41 @@ impl Ctx<'_> {
     }
 }
 
+/// The model an earlier run of the experiments left in `dir` (the generalisation's or the
+/// sensors' CNN-BiLSTM), when it was trained on the same data under the same protocol
+/// (`channels`, or its own; windows of `window` steps) and calibrated with its envelope:
+/// reused, not trained again.
+fn earlier(
+    ctx: &Ctx,
+    dir: &Path,
+    ds: &DataSet,
+    channels: Option<&[String]>,
+    window: usize,
+) -> Option<Model> {
+    let m = Model::load(dir).ok()?;
+    let channels = channels.map_or_else(|| m.meta.data.channels.clone(), |c| c.to_vec());
+    let mut spec = ctx
+        .spec_windowed(
+            ds,
+            &channels,
+            &ctx.labels(),
+            NoiseProtocol::Matched,
+            ctx.split.clone(),
+            window,
+        )
+        .ok()?;
+    // The noise the experiments train with (`ds` may be the clean data).
+    spec.noise_model = Some(ctx.opts.noise(ctx.opts.snr_db));
+    let same = m.meta.kind == ModelKind::CnnBiLstm
+        && m.meta.data == spec
+        && m.meta.data_identity["data_fnv1a"].as_str() == Some(ctx.data_hash.as_str())
+        && m.meta
+            .calibration
+            .as_ref()
+            .is_some_and(|c| !c.envelope.is_empty());
+    same.then_some(m)
+}
+
 /// Simulates `plan` (clean, NPZ, 3 s settling) into `dir`, resuming what is there.
 fn simulate(plan: &Plan, dir: &Path, jobs: usize) -> Result<()> {
     let gopts = GenerateOptions {
@@ -520,6 +562,7 @@ pub fn run(
             Which::Robustness => robustness::run(&mut ctx)?,
             Which::Protocols => protocols::run(&mut ctx)?,
             Which::Sensors => sensors::run(&mut ctx)?,
+            Which::ModelForm => model_form::run(&mut ctx)?,
             _ => mismatch::run(&mut ctx)?,
         };
         let secs = ts.elapsed().as_secs_f64();

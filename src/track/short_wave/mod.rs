@@ -153,6 +153,32 @@ impl ShortWaves {
     }
 }
 
+/// The short waves of `current` with the roughness of `spectrum` in place of the file's (its
+/// defaults: down to [`DEFAULT_MIN_WAVELENGTH`] from where the irregularities stop, the
+/// contact filter on, the irregularities' seed), or without roughness (`None`); the welds
+/// stay. `geometry` as [`from_file`]'s.
+pub fn with_roughness(
+    current: Option<ShortWaveSpec>,
+    spectrum: Option<RoughnessSpectrum>,
+    geometry: Option<(f64, u64, f64, f64)>,
+) -> Option<ShortWaveSpec> {
+    let (geo_min, seed, smooth_start, fade_in) = geometry.unwrap_or((1.0, 1, 20.0, 50.0));
+    let roughness = spectrum.map(|spectrum| RoughnessSpec {
+        spectrum,
+        min_wavelength: DEFAULT_MIN_WAVELENGTH.min(0.5 * geo_min),
+        max_wavelength: geo_min,
+        contact_filter: true,
+        seed,
+    });
+    let welds = current.and_then(|c| c.welds);
+    (roughness.is_some() || welds.is_some()).then_some(ShortWaveSpec {
+        roughness,
+        welds,
+        smooth_start: current.map_or(smooth_start, |c| c.smooth_start),
+        fade_in: current.map_or(fade_in, |c| c.fade_in),
+    })
+}
+
 /// `[roughness]` in a track file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

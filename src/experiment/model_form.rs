@@ -1,0 +1,223 @@
+//! Beyond the paper (assets/docs/learning.md §4.7): the simulator's own form. The same
+//! CNN-BiLSTM trained on data from the lumped track and tested on rails on sleepers, and the
+//! other way round: how far an identification network carries across a change of the model
+//! that made its labels, the nearest honest proxy for the gap between a simulator and a line.
+//! The plan's every run is simulated again with `rail_support = "discrete"` (the same
+//! conditions, seeds and irregularities), and the labels' physics beside it: FL's and FQ's
+//! standard deviation per condition on both tracks.
+
+use super::{Ctx, FitJob, PAPER21, earlier, f4};
+use crate::dataset::DataSet;
+use crate::error::Result;
+use crate::features::NoiseProtocol;
+use crate::learn::evaluate::{EvalPart, evaluate};
+use crate::learn::model::{Model, ModelKind};
+use crate::plan::Plan;
+use crate::report::Section;
+use crate::report::table::Table;
+use std::time::Instant;
+
+/// Standard deviation of each label of `ds`'s runs of seed `seed` in condition `name`, kN
+/// (pooled over those runs, each run's own mean removed).
+fn label_sd(ds: &DataSet, name: &str, seeds: &[u64]) -> Result<[f64; 2]> {
+    let mut out = [0.0; 2];
+    for (k, label) in ds.labels.iter().enumerate() {
+        let col = ds.channel(label)?;
+        let (mut ss, mut n) = (0.0, 0usize);
+        for r in ds
+            .runs
+            .iter()
+            .filter(|r| r.condition == name && seeds.contains(&r.seed))
+        {
+            let x = &r.columns[col];
+            let m = x.iter().sum::<f64>() / x.len().max(1) as f64;
+            ss += x.iter().map(|v| (v - m).powi(2)).sum::<f64>();
+            n += x.len();
+        }
+        out[k] = (ss / n.max(1) as f64).sqrt() * 1e-3;
+    }
+    Ok(out)
+}
+
+/// The CNN-BiLSTM on `inputs` predicting `labels` on `ds` under the experiments' split.
+fn fit_job<'a>(
+    ctx: &Ctx,
+    ds: &'a DataSet,
+    inputs: &[String],
+    labels: &[String],
+    dir: std::path::PathBuf,
+) -> Result<FitJob<'a>> {
+    Ok(FitJob {
+        ds,
+        spec: ctx.spec(
+            ds,
+            inputs,
+            labels,
+            NoiseProtocol::Matched,
+            ctx.split.clone(),
+        )?,
+        kind: ModelKind::CnnBiLstm,
+        dir,
+        windows: None,
+        members: 1,
+        seed_offset: 0,
+    })
+}
+
+pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
+    let opts = ctx.opts;
+    let t0 = Instant::now();
+    let plan = Plan::load(&opts.plan)?;
+    let mut beams = plan.clone();
+    beams.name = format!("{}_on_sleepers", plan.name);
+    for c in &mut beams.conditions {
+        c.rail_support = Some("discrete".into());
+    }
+    let dir = opts.out.join("model_form");
+    let data = dir.join("data/on_sleepers");
+    (ctx.log)(format!(
+        "simulating {} runs of {} into {} (resumable) …",
+        beams
+            .conditions
+            .iter()
+            .map(|c| c.seeds.len())
+            .sum::<usize>(),
+        beams.name,
+        data.display()
+    ));
+    let ts = Instant::now();
+    super::simulate(&beams, &data, opts.jobs)?;
+    let sim_s = ts.elapsed().as_secs_f64();
+    let paper = Ctx::paper21();
+    let labels = ctx.labels();
+    let mut keep: Vec<String> = vec!["time_s".into()];
+    keep.extend(labels.iter().cloned());
+    keep.extend(paper.iter().cloned());
+    let lumped_clean = ctx.ds.subset(None, Some(&keep))?;
+    let beams_clean = DataSet::load(&data)?.subset(None, Some(&keep))?;
+    let lumped = ctx.noisy(&lumped_clean, opts.snr_db, &paper)?;
+    let on_beams = ctx.noisy(&beams_clean, opts.snr_db, &paper)?;
+
+    // The lumped-trained network: the generalisation part's, where it ran on the same data
+    // and protocol (in this invocation or earlier into the same folder), else trained here.
+    let paper21_dir = opts.out.join("generalization/models/all_conditions");
+    let reused = match ctx.trained.iter().find(|(k, _)| *k == PAPER21) {
+        Some((_, d)) => Some(d.clone()),
+        None => earlier(ctx, &paper21_dir, &lumped, Some(&paper), opts.window)
+            .map(|_| paper21_dir.clone()),
+    };
+    let job =
+        |ds, name: &str| fit_job(ctx, ds, &paper, &labels, dir.join(format!("models/{name}")));
+    let mut jobs = vec![job(&on_beams, "on_sleepers")?];
+    if reused.is_none() {
+        jobs.push(job(&lumped, "lumped")?);
+    }
+    let tt = Instant::now();
+    let mut fitted = ctx.fit_all(&jobs)?.into_iter().map(|(m, _)| m);
+    let train_s = tt.elapsed().as_secs_f64();
+    let beams_model = fitted.next().expect("the model trained on sleepers");
+    let lumped_model = match &reused {
+        Some(d) => {
+            (ctx.log)(format!(
+                "reusing {} (trained earlier on the same data and protocol)",
+                d.display()
+            ));
+            Model::load(d)?
+        }
+        None => fitted.next().expect("the lumped model"),
+    };
+    let mut models: Vec<(&str, Model)> = vec![
+        ("lumped rail masses", lumped_model),
+        ("rails on sleepers", beams_model),
+    ];
+    let sets: [(&str, &DataSet); 2] = [
+        ("lumped rail masses", &lumped),
+        ("rails on sleepers", &on_beams),
+    ];
+    let mut t = Table::new(&[
+        "trained on",
+        "tested on",
+        "windows",
+        "FL R²",
+        "FL RMSE kN",
+        "FQ R²",
+        "FQ RMSE kN",
+    ]);
+    for (trained, model) in models.iter_mut() {
+        for (tested, ds) in sets {
+            let ev = evaluate(model, ds, EvalPart::Test)?;
+            let m = &ev.metrics;
+            t.push(vec![
+                trained.to_string(),
+                tested.to_string(),
+                m[0].n.to_string(),
+                f4(m[0].r2),
+                format!("{:.2}", m[0].rmse_kn),
+                f4(m[1].r2),
+                format!("{:.2}", m[1].rmse_kn),
+            ]);
+        }
+    }
+    // The labels' physics on both tracks, the test seeds' runs of each condition.
+    let test_seeds = match &ctx.split {
+        crate::features::Split::Seeds { test, .. } => test.clone(),
+        _ => lumped_clean.seeds(),
+    };
+    let mut phys = Table::new(&[
+        "condition",
+        "FL sd kN, lumped",
+        "FL sd kN, sleepers",
+        "FQ sd kN, lumped",
+        "FQ sd kN, sleepers",
+    ]);
+    for c in &ctx.conditions {
+        let (a, b) = (
+            label_sd(&lumped_clean, c, &test_seeds)?,
+            label_sd(&beams_clean, c, &test_seeds)?,
+        );
+        phys.push(vec![
+            c.clone(),
+            format!("{:.2}", a[0]),
+            format!("{:.2}", b[0]),
+            format!("{:.2}", a[1]),
+            format!("{:.2}", b[1]),
+        ]);
+    }
+    Ok(Section {
+        title: "7. The simulator's form: lumped track against rails on sleepers (not in the paper)".into(),
+        text: vec![
+            format!(
+                "Every run of the plan simulated again on rails on discrete sleepers ({}: rails as beams on pads, sleepers, ballast and subgrade, the same conditions, seeds and irregularities, 0.25 ms), and one CNN-BiLSTM on the paper's 21 trained on each track's data under the same split and noise: each tested on its own track and on the other. A network that keeps its R² across the change of track model carries what it learned from the vehicle, not from one track model's numbers.",
+                beams.name
+            ),
+            format!(
+                "The lumped-trained network is the generalisation part's ({}).",
+                if reused.is_some() {
+                    "reused: trained on the same data and protocol"
+                } else {
+                    "trained here: the generalisation part did not leave it"
+                }
+            ),
+            ctx.protocol(&ctx.split, Some(opts.snr_db)),
+            format!(
+                "Time: simulation on sleepers {sim_s:.0} s, trainings {train_s:.0} s ({} network{}); the part {:.0} s.",
+                jobs.len(),
+                if jobs.len() == 1 { "" } else { "s" },
+                t0.elapsed().as_secs_f64()
+            ),
+        ],
+        tables: vec![
+            (
+                "Trained on one track model, tested on both: R² and RMSE in kN on the test runs".into(),
+                t,
+                "model_form".into(),
+            ),
+            (
+                "The labels on both tracks: FL's and FQ's standard deviation on the test runs of each condition (clean)".into(),
+                phys,
+                "labels".into(),
+            ),
+        ],
+        figures: Vec::new(),
+    })
+}
