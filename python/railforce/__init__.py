@@ -74,6 +74,7 @@ def simulate(
     consist: str = "none",
     position: Optional[float] = None,
     rail_support: Optional[str] = None,
+    roughness: Optional[str] = None,
 ):
     """One run of ``vehicle`` on ``track``, exactly as ``railforce simulate`` makes it.
 
@@ -88,7 +89,9 @@ def simulate(
     wagon's place as a fraction of the train from the head) as ``--consist`` and
     ``--position`` take them; a run in a train adds the ``coupler_*`` channels.
     ``rail_support`` (``"rigid"``, ``"lumped"``, ``"discrete"``: rails on sleepers, 0.25 ms
-    unless ``dt``) as ``--rail-support`` chooses it over the track file's.
+    unless ``dt``) as ``--rail-support`` chooses it over the track file's; ``roughness``
+    (``"iso3095"``, ``"cnossos_m"``, ``"none"``) as ``--roughness`` puts rail roughness on the
+    rails (the step then follows it: 62.5 µs).
     """
     cols = _native.simulate(
         os.fspath(track),
@@ -104,6 +107,7 @@ def simulate(
         str(consist),
         None if position is None else float(position),
         None if rail_support is None else str(rail_support),
+        None if roughness is None else str(roughness),
     )
     return _frame(cols, as_frame)
 

@@ -173,3 +173,18 @@ def test_simulate_on_sleepers_matches_the_cli(cli, tmp_path):
     with pytest.raises(ValueError, match="discrete sleepers"):
         railforce.simulate(track="curve_r400", duration_s=0.5, rail_support="discrete",
                            integrator="heun")
+
+
+def test_simulate_over_roughness_matches_the_cli(cli, tmp_path):
+    out = tmp_path / "rough.npz"
+    subprocess.run(
+        [str(cli), "simulate", "--track", "tangent", "--speed-kmh", "80", "--duration", "0.3",
+         "--settle", "0.3", "--seed", "7", "--roughness", "cnossos_m", "--out", str(out)],
+        check=True, capture_output=True,
+    )
+    ref = np.load(out)
+    py = railforce.simulate(track="tangent", speed_kmh=80, duration_s=0.3, settle_s=0.3, seed=7,
+                            roughness="cnossos_m")
+    np.testing.assert_array_equal(py["w1l_force_z"], ref["w1l_force_z"])
+    with pytest.raises(ValueError, match="too coarse"):
+        railforce.simulate(track="tangent", duration_s=0.3, roughness="iso3095", dt=5e-4)

@@ -61,20 +61,64 @@ pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
         doc("learning.md"),
         doc("glossary.md"),
     );
-    let commit = meta["commit"].as_str().unwrap_or("unknown");
+    // Each part's own provenance (parts may run into one folder at different times).
+    let parts: Vec<(&str, serde_json::Value)> = Which::FOLDERS
+        .iter()
+        .filter(|f| !missing.iter().any(|m| m == *f))
+        .filter_map(|f| read_json(&out.join(f).join("meta.json")).map(|m| (*f, m)))
+        .collect();
+    let mut commits: Vec<(String, Vec<&str>)> = Vec::new();
+    for (f, m) in &parts {
+        let c = m["commit"]
+            .as_str()
+            .or(meta["commit"].as_str())
+            .unwrap_or("unknown")
+            .to_string();
+        match commits.iter_mut().find(|(k, _)| *k == c) {
+            Some((_, fs)) => fs.push(f),
+            None => commits.push((c, vec![f])),
+        }
+    }
+    let commit = match commits.as_slice() {
+        [] => format!("`{}`", meta["commit"].as_str().unwrap_or("unknown")),
+        [(c, _)] => format!("`{c}`"),
+        many => many
+            .iter()
+            .map(|(c, fs)| format!("`{c}` ({})", fs.join(", ")))
+            .collect::<Vec<_>>()
+            .join(", "),
+    };
+    let one_run = commits.len() <= 1
+        && parts
+            .iter()
+            .all(|(f, _)| meta["timings"][format!("{f}_s")].is_number());
+    let parts_wall: f64 = parts
+        .iter()
+        .filter_map(|(_, m)| m["wall_seconds"].as_f64())
+        .sum();
     if missing.is_empty() {
         md += &format!(
-            "- **Run:** finished {} (UTC), railforce {}, commit `{}`, {} wall time in all.\n",
+            "- **Run:** finished {} (UTC), railforce {}, commit {}, {}.\n",
             meta["finished_unix"]
                 .as_u64()
                 .map_or("?".into(), utc_date_time),
             meta["railforce_version"].as_str().unwrap_or("?"),
             commit,
-            minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0)),
+            if one_run {
+                format!(
+                    "{} wall time in all",
+                    minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0))
+                )
+            } else {
+                format!(
+                    "its parts run into one folder at different times, {} of wall time added",
+                    minutes(parts_wall)
+                )
+            },
         );
     } else {
         md += &format!(
-            "- **Run:** not finished: the parts below are those that had finished by {} (UTC), railforce {}, commit `{}`; **not in this snapshot: {}** (no figure of theirs is quoted from another run).\n",
+            "- **Run:** not finished: the parts below are those that had finished by {} (UTC), railforce {}, commit {}; **not in this snapshot: {}** (no figure of theirs is quoted from another run).\n",
             meta["finished_unix"]
                 .as_u64()
                 .map_or("?".into(), utc_date_time),
@@ -90,19 +134,25 @@ pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
     md += "## Headline\n\n";
     md += &headline_block(out)?;
     md += "\n## Wall time of each part\n\n";
-    let mut wt = Table::new(&["part", "wall time"]);
-    for f in Which::FOLDERS {
-        if let Some(s) = meta["timings"][format!("{f}_s")].as_f64() {
-            wt.push(vec![f.to_string(), minutes(s)]);
+    let mut wt = Table::new(&["part", "commit", "wall time"]);
+    for (f, m) in &parts {
+        if let Some(s) = m["wall_seconds"].as_f64() {
+            let c = m["commit"].as_str().unwrap_or("unknown");
+            wt.push(vec![f.to_string(), c.chars().take(7).collect(), minutes(s)]);
         }
     }
     wt.push(vec![
-        if missing.is_empty() {
+        if missing.is_empty() && one_run {
             "all, with the simulation of the data".into()
         } else {
-            "the parts above".into()
+            "the parts above, added".into()
         },
-        minutes(meta["wall_seconds"].as_f64().unwrap_or(0.0)),
+        String::new(),
+        minutes(if one_run {
+            meta["wall_seconds"].as_f64().unwrap_or(0.0)
+        } else {
+            parts_wall
+        }),
     ]);
     md += &wt.markdown();
     // The experiments' parts, then a sensitivity study run into the same folder

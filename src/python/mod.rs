@@ -75,7 +75,7 @@ fn dict_of_arrays<'py>(
 
 /// One run, as `railforce simulate` makes it; returns its recorded channels.
 #[pyfunction]
-#[pyo3(signature = (track, vehicle, speed_kmh, duration_s, seed, channels, settle_s, dt, integrator, keep_going, consist="none", position=None, rail_support=None))]
+#[pyo3(signature = (track, vehicle, speed_kmh, duration_s, seed, channels, settle_s, dt, integrator, keep_going, consist="none", position=None, rail_support=None, roughness=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -92,6 +92,7 @@ fn simulate<'py>(
     consist: &str,
     position: Option<f64>,
     rail_support: Option<&str>,
+    roughness: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = RunRequest {
         speed_kmh,
@@ -115,6 +116,9 @@ fn simulate<'py>(
             let mut spec = TrackSpec::load(&track)?;
             if let Some(m) = rail_support {
                 spec.set_rail_model(m)?;
+            }
+            if let Some(r) = roughness {
+                spec.set_roughness(r)?;
             }
             let mut cfg = cfg;
             cfg.dt = request.stepping.step_on(&spec, &vehicle, cfg.speed)?;
