@@ -146,64 +146,6 @@ pub struct TrackSpec {
 pub const RAIL_SUPPORT_MODELS: [&str; 3] = ["rigid", "lumped", "discrete"];
 
 impl TrackSpec {
-    /// Chooses the rails' support by name, over the file's (`simulate --rail-support`, the
-    /// plan key `rail_support`): "rigid", "lumped" (the file's lumped masses, which it must
-    /// have) or "discrete" (the file's discrete parameters, else the default set).
-    pub fn set_rail_model(&mut self, model: &str) -> crate::error::Result<()> {
-        match model {
-            "rigid" => (self.rail_support, self.discrete_rails) = (None, None),
-            "lumped" => {
-                if self.rail_support.is_none() {
-                    return Err(crate::error::Error::Domain(format!(
-                        "rail support \"lumped\": track '{}' has no lumped [rail_support] masses to take",
-                        self.name
-                    )));
-                }
-                self.discrete_rails = None;
-            }
-            "discrete" => {
-                self.discrete_rails = Some(self.discrete_rails.unwrap_or_default());
-                self.rail_support = None;
-            }
-            other => {
-                return Err(crate::error::Error::Domain(format!(
-                    "rail support must be \"rigid\", \"lumped\" or \"discrete\", got \"{other}\""
-                )));
-            }
-        }
-        Ok(())
-    }
-
-    /// Puts rail roughness of the named spectrum on the rails over the file's
-    /// (`simulate --roughness`, the plan key `roughness`): one of
-    /// [`super::short_wave::RoughnessSpectrum::NAMES`] at its defaults, or "none".
-    pub fn set_roughness(&mut self, name: &str) -> crate::error::Result<()> {
-        use super::short_wave::{RoughnessSpectrum, with_roughness};
-        let spectrum = match name {
-            "none" => None,
-            n => Some(RoughnessSpectrum::parse(n).ok_or_else(|| {
-                crate::error::Error::Domain(format!(
-                    "roughness must be \"none\" or one of {}, got \"{n}\"",
-                    RoughnessSpectrum::NAMES.join(", ")
-                ))
-            })?),
-        };
-        let geometry = self
-            .irregularity
-            .map(|i| (i.min_wavelength, i.seed, i.smooth_start, i.fade_in));
-        self.short_waves = with_roughness(self.short_waves, spectrum, geometry);
-        Ok(())
-    }
-
-    /// The rails' support by name: "rigid", "lumped" or "discrete".
-    pub fn rail_model(&self) -> &'static str {
-        match (self.rail_support, self.discrete_rails) {
-            (_, Some(_)) => "discrete",
-            (Some(_), None) => "lumped",
-            (None, None) => "rigid",
-        }
-    }
-
     /// Whether any section is a curve.
     pub fn has_curves(&self) -> bool {
         self.sections

@@ -51,6 +51,45 @@ pub struct RailSupport {
     pub vertical: Support,
 }
 
+impl super::TrackSpec {
+    /// Chooses the rails' support by name, over the file's (`simulate --rail-support`, the
+    /// plan key `rail_support`): "rigid", "lumped" (the file's lumped masses, which it must
+    /// have) or "discrete" (the file's discrete parameters, else the default set).
+    pub fn set_rail_model(&mut self, model: &str) -> Result<()> {
+        match model {
+            "rigid" => (self.rail_support, self.discrete_rails) = (None, None),
+            "lumped" => {
+                if self.rail_support.is_none() {
+                    return Err(Error::Domain(format!(
+                        "rail support \"lumped\": track '{}' has no lumped [rail_support] masses to take",
+                        self.name
+                    )));
+                }
+                self.discrete_rails = None;
+            }
+            "discrete" => {
+                self.discrete_rails = Some(self.discrete_rails.unwrap_or_default());
+                self.rail_support = None;
+            }
+            other => {
+                return Err(Error::Domain(format!(
+                    "rail support must be \"rigid\", \"lumped\" or \"discrete\", got \"{other}\""
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The rails' support by name: "rigid", "lumped" or "discrete".
+    pub fn rail_model(&self) -> &'static str {
+        match (self.rail_support, self.discrete_rails) {
+            (_, Some(_)) => "discrete",
+            (Some(_), None) => "lumped",
+            (None, None) => "rigid",
+        }
+    }
+}
+
 /// `[rail_support]` in a track file: `model = "lumped"` (the default: the six keys below) or
 /// `model = "discrete"` (rails on sleepers, [`super::discrete`]; its keys, all optional, in
 /// `[rail_support.discrete]`).

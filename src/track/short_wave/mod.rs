@@ -179,6 +179,28 @@ pub fn with_roughness(
     })
 }
 
+impl super::TrackSpec {
+    /// Puts rail roughness of the named spectrum on the rails over the file's
+    /// (`simulate --roughness`, the plan key `roughness`): one of
+    /// [`super::short_wave::RoughnessSpectrum::NAMES`] at its defaults, or "none".
+    pub fn set_roughness(&mut self, name: &str) -> crate::error::Result<()> {
+        let spectrum = match name {
+            "none" => None,
+            n => Some(RoughnessSpectrum::parse(n).ok_or_else(|| {
+                crate::error::Error::Domain(format!(
+                    "roughness must be \"none\" or one of {}, got \"{n}\"",
+                    RoughnessSpectrum::NAMES.join(", ")
+                ))
+            })?),
+        };
+        let geometry = self
+            .irregularity
+            .map(|i| (i.min_wavelength, i.seed, i.smooth_start, i.fade_in));
+        self.short_waves = with_roughness(self.short_waves, spectrum, geometry);
+        Ok(())
+    }
+}
+
 /// `[roughness]` in a track file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
