@@ -243,7 +243,9 @@ fn every_experiment_runs_end_to_end() {
             .starts_with("trained_on,tested_on,windows,fl_r2,fl_rmse_kn,fq_r2,fq_rmse_kn"),
         "{form}"
     );
-    assert_eq!(form.lines().count(), 1 + 4, "{form}");
+    // Two networks on three test sets: each track model, and short waves on the lumped one.
+    assert_eq!(form.lines().count(), 1 + 6, "{form}");
+    assert!(form.contains("lumped, cnossos_m roughness"), "{form}");
     assert!(
         form.contains("lumped rail masses,rails on sleepers"),
         "{form}"
@@ -257,6 +259,16 @@ fn every_experiment_runs_end_to_end() {
     let sleepers =
         std::fs::read_to_string(out.join("model_form/data/on_sleepers/manifest.json")).unwrap();
     assert!(sleepers.contains("discrete"), "the runs on sleepers say so");
+    let rough =
+        std::fs::read_to_string(out.join("model_form/data/cnossos_m/manifest.json")).unwrap();
+    assert!(
+        rough.contains("\"roughness\": \"cnossos_m\""),
+        "the rough runs say so"
+    );
+    assert!(
+        header("model_form/labels.csv").contains("fq_20_50_hz_kn_rough"),
+        "{labels}"
+    );
     // The lumped network is the generalisation part's, not trained again.
     assert!(!out.join("model_form/models/lumped").exists());
     assert!(html.contains("lumped track against rails on sleepers"));

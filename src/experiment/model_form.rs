@@ -3,8 +3,10 @@
 //! other way round: how far an identification network carries across a change of the model
 //! that made its labels, the nearest honest proxy for the gap between a simulator and a line.
 //! The plan's every run is simulated again with `rail_support = "discrete"` (the same
-//! conditions, seeds and irregularities), and the labels' physics beside it: FL's and FQ's
-//! standard deviation per condition on both tracks.
+//! conditions, seeds and irregularities), and its test runs once more on the lumped track with
+//! CNOSSOS rail roughness below the irregularities (short waves no training run had); the
+//! labels' physics beside it: FL's and FQ's standard deviation and FQ's 20–50 Hz band per
+//! condition on all three.
 
 use super::{Ctx, FitJob, PAPER21, earlier, f4};
 use crate::dataset::DataSet;
@@ -17,7 +19,27 @@ use crate::report::Section;
 use crate::report::table::Table;
 use std::time::Instant;
 
-/// Standard deviation of each label of `ds`'s runs of seed `seed` in condition `name`, kN
+/// The rail roughness of the short-wave test set.
+const ROUGHNESS: &str = "cnossos_m";
+
+/// FQ's rms in its 20–50 Hz band (sleeper passing, the short waves) over `ds`'s runs of
+/// `seeds` in condition `name`, kN (power averaged over the runs).
+fn fq_band(ds: &DataSet, name: &str, seeds: &[u64]) -> Result<f64> {
+    let col = ds.channel(&ds.labels[1])?;
+    let (mut p, mut n) = (0.0, 0usize);
+    for r in ds
+        .runs
+        .iter()
+        .filter(|r| r.condition == name && seeds.contains(&r.seed))
+    {
+        let b = crate::sim::step_study::band_rms(&r.columns[col], crate::sensors::RATE_HZ);
+        p += b[1] * b[1];
+        n += 1;
+    }
+    Ok((p / n.max(1) as f64).sqrt() * 1e-3)
+}
+
+/// Standard deviation of each label of `ds`'s runs of `seeds` in condition `name`, kN
 /// (pooled over those runs, each run's own mean removed).
 fn label_sd(ds: &DataSet, name: &str, seeds: &[u64]) -> Result<[f64; 2]> {
     let mut out = [0.0; 2];
@@ -87,6 +109,32 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     ));
     let ts = Instant::now();
     super::simulate(&beams, &data, opts.jobs)?;
+    let test_seeds = match &ctx.split {
+        crate::features::Split::Seeds { test, .. } => test.clone(),
+        _ => plan
+            .conditions
+            .first()
+            .map(|c| c.seeds.clone())
+            .unwrap_or_default(),
+    };
+    let mut rough = plan.clone();
+    rough.name = format!("{}_{ROUGHNESS}", plan.name);
+    for c in &mut rough.conditions {
+        c.roughness = Some(ROUGHNESS.into());
+        c.seeds = test_seeds.clone();
+    }
+    let rough_data = dir.join(format!("data/{ROUGHNESS}"));
+    (ctx.log)(format!(
+        "simulating {} runs of {} into {} (resumable) …",
+        rough
+            .conditions
+            .iter()
+            .map(|c| c.seeds.len())
+            .sum::<usize>(),
+        rough.name,
+        rough_data.display()
+    ));
+    super::simulate(&rough, &rough_data, opts.jobs)?;
     let sim_s = ts.elapsed().as_secs_f64();
     let paper = Ctx::paper21();
     let labels = ctx.labels();
@@ -95,8 +143,10 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     keep.extend(paper.iter().cloned());
     let lumped_clean = ctx.ds.subset(None, Some(&keep))?;
     let beams_clean = DataSet::load(&data)?.subset(None, Some(&keep))?;
+    let rough_clean = DataSet::load(&rough_data)?.subset(None, Some(&keep))?;
     let lumped = ctx.noisy(&lumped_clean, opts.snr_db, &paper)?;
     let on_beams = ctx.noisy(&beams_clean, opts.snr_db, &paper)?;
+    let on_rough = ctx.noisy(&rough_clean, opts.snr_db, &paper)?;
 
     // The lumped-trained network: the generalisation part's, where it ran on the same data
     // and protocol (in this invocation or earlier into the same folder), else trained here.
@@ -130,9 +180,11 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         ("lumped rail masses", lumped_model),
         ("rails on sleepers", beams_model),
     ];
-    let sets: [(&str, &DataSet); 2] = [
-        ("lumped rail masses", &lumped),
-        ("rails on sleepers", &on_beams),
+    let short = format!("lumped, {ROUGHNESS} roughness");
+    let sets: [(&str, &DataSet, EvalPart); 3] = [
+        ("lumped rail masses", &lumped, EvalPart::Test),
+        ("rails on sleepers", &on_beams, EvalPart::Test),
+        (&short, &on_rough, EvalPart::All),
     ];
     let mut t = Table::new(&[
         "trained on",
@@ -144,8 +196,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         "FQ RMSE kN",
     ]);
     for (trained, model) in models.iter_mut() {
-        for (tested, ds) in sets {
-            let ev = evaluate(model, ds, EvalPart::Test)?;
+        for (tested, ds, part) in sets {
+            let ev = evaluate(model, ds, part)?;
             let m = &ev.metrics;
             t.push(vec![
                 trained.to_string(),
@@ -158,30 +210,33 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             ]);
         }
     }
-    // The labels' physics on both tracks, the test seeds' runs of each condition.
-    let test_seeds = match &ctx.split {
-        crate::features::Split::Seeds { test, .. } => test.clone(),
-        _ => lumped_clean.seeds(),
-    };
+    // The labels' physics on the three, the test seeds' runs of each condition.
     let mut phys = Table::new(&[
         "condition",
         "FL sd kN, lumped",
         "FL sd kN, sleepers",
+        "FL sd kN, rough",
         "FQ sd kN, lumped",
         "FQ sd kN, sleepers",
+        "FQ sd kN, rough",
+        "FQ 20–50 Hz kN, lumped",
+        "FQ 20–50 Hz kN, sleepers",
+        "FQ 20–50 Hz kN, rough",
     ]);
+    let all = [&lumped_clean, &beams_clean, &rough_clean];
     for c in &ctx.conditions {
-        let (a, b) = (
-            label_sd(&lumped_clean, c, &test_seeds)?,
-            label_sd(&beams_clean, c, &test_seeds)?,
-        );
-        phys.push(vec![
-            c.clone(),
-            format!("{:.2}", a[0]),
-            format!("{:.2}", b[0]),
-            format!("{:.2}", a[1]),
-            format!("{:.2}", b[1]),
-        ]);
+        let mut row = vec![c.clone()];
+        let sds = all
+            .iter()
+            .map(|ds| label_sd(ds, c, &test_seeds))
+            .collect::<Result<Vec<_>>>()?;
+        for k in 0..2 {
+            row.extend(sds.iter().map(|sd| format!("{:.2}", sd[k])));
+        }
+        for ds in all {
+            row.push(format!("{:.2}", fq_band(ds, c, &test_seeds)?));
+        }
+        phys.push(row);
     }
     Ok(Section {
         title: "7. The simulator's form: lumped track against rails on sleepers (not in the paper)".into(),
@@ -189,6 +244,10 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             format!(
                 "Every run of the plan simulated again on rails on discrete sleepers ({}: rails as beams on pads, sleepers, ballast and subgrade, the same conditions, seeds and irregularities, 0.25 ms), and one CNN-BiLSTM on the paper's 21 trained on each track's data under the same split and noise: each tested on its own track and on the other. A network that keeps its R² across the change of track model carries what it learned from the vehicle, not from one track model's numbers.",
                 beams.name
+            ),
+            format!(
+                "Both also tested on short waves no training run had: the test runs again on the lumped track with {ROUGHNESS} rail roughness below the irregularities ({}: CNOSSOS-EU's average network from 1 m down to 0.1 m through the contact filter, 62.5 µs; physics.md §3.4).",
+                rough.name
             ),
             format!(
                 "The lumped-trained network is the generalisation part's ({}).",
@@ -208,12 +267,12 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         ],
         tables: vec![
             (
-                "Trained on one track model, tested on both: R² and RMSE in kN on the test runs".into(),
+                "Trained on one track model, tested on both and on short waves: R² and RMSE in kN on the test runs".into(),
                 t,
                 "model_form".into(),
             ),
             (
-                "The labels on both tracks: FL's and FQ's standard deviation on the test runs of each condition (clean)".into(),
+                "The labels on the three: FL's and FQ's standard deviation and FQ's rms in 20–50 Hz (sleeper passing, short waves) on the test runs of each condition (clean)".into(),
                 phys,
                 "labels".into(),
             ),
