@@ -212,6 +212,9 @@ pub struct Condition {
     /// Rail roughness instead of the track file's (`roughness = "iso3095"`, `"cnossos_m"` or
     /// `"none"`, [`crate::track::TrackSpec::set_roughness`]; None: the file's).
     pub roughness: Option<String>,
+    /// The seeds as the plan file lists them, which [`Turns::Both`] counts in: a plan narrowed
+    /// to some of them ([`Condition::only_seeds`]) turns each kept run as the whole plan does.
+    pub turn_order: Vec<u64>,
 }
 
 impl Condition {
@@ -234,13 +237,18 @@ impl Condition {
         self.speed_kmh / 3.6
     }
 
+    /// The condition with only `seeds` to run, each turning as it does in the whole plan.
+    pub fn only_seeds(&mut self, seeds: &[u64]) {
+        self.seeds = seeds.to_vec();
+    }
+
     /// Whether the run of seed `seed` turns its curves the other way from its track file.
     pub fn mirrored(&self, seed: u64) -> bool {
         match self.turns {
             Turns::AsDrawn => false,
             Turns::Mirrored => true,
             Turns::Both => {
-                let k = self.seeds.iter().position(|&s| s == seed).unwrap_or(0);
+                let k = self.turn_order.iter().position(|&s| s == seed).unwrap_or(0);
                 (k + self.order) % 2 == 1
             }
         }
@@ -453,7 +461,9 @@ impl Plan {
                 )?,
                 None => None,
             };
+            let turn_order = seeds.clone();
             conditions.push(Condition {
+                turn_order,
                 vary,
                 name: c.name,
                 track: dir.join(c.track),

@@ -430,3 +430,25 @@ fn a_plan_puts_roughness_on_its_rails() {
     assert!(e.contains("roughness") && e.contains("rough"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A plan narrowed to some seeds (the test seeds an experiment runs again) turns each kept run
+/// as the whole plan does: `turn = "both"` counts in the plan file's seed list.
+#[test]
+fn a_narrowed_plan_turns_its_runs_as_the_whole_plan() {
+    let dir = temp("narrowed");
+    let p = plan(
+        &dir,
+        "turn = \"both\"",
+        "[[condition]]\nname = \"t\"\ntrack = \"tangent.toml\"\nspeed_kmh = 60.0\n\
+         [[condition]]\nname = \"c\"\ntrack = \"r400.toml\"\nspeed_kmh = 60.0\n",
+    );
+    for c in &p.conditions {
+        let whole: Vec<bool> = [1, 2].iter().map(|&s| c.mirrored(s)).collect();
+        assert_ne!(whole[0], whole[1], "both ways over the two seeds");
+        let mut only = c.clone();
+        only.only_seeds(&[2]);
+        assert_eq!(only.seeds, vec![2]);
+        assert_eq!(only.mirrored(2), whole[1], "{}", c.name);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -29,7 +29,8 @@ pub enum WhichArg {
     Mismatch,
     /// The simulator's form: the CNN-BiLSTM (paper's 21) trained on the lumped track and
     /// tested on rails on sleepers (every run simulated again on them), and the other way
-    /// round; the labels' spread on both tracks per condition.
+    /// round, both also on the test runs with CNOSSOS rail roughness; the labels' spread on
+    /// the three per condition.
     ModelForm,
     /// The paper's three: comparison, generalization, robustness.
     Paper,

@@ -89,6 +89,7 @@ fn with_fleet(plan: &Plan, fleet: &Plan) -> Result<Plan> {
         for s in &f.seeds {
             if !c.seeds.contains(s) {
                 c.seeds.push(*s);
+                c.turn_order.push(*s);
             }
         }
     }
@@ -112,7 +113,7 @@ fn extreme(plan: &Plan, name: &str, table: &str, seeds: &[u64], drop: bool) -> R
     p.drop_derailed = drop;
     for c in &mut p.conditions {
         c.vary = vary.clone();
-        c.seeds = seeds.to_vec();
+        c.only_seeds(seeds);
     }
     Ok(p)
 }

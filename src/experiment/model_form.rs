@@ -121,7 +121,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     rough.name = format!("{}_{ROUGHNESS}", plan.name);
     for c in &mut rough.conditions {
         c.roughness = Some(ROUGHNESS.into());
-        c.seeds = test_seeds.clone();
+        c.only_seeds(&test_seeds);
     }
     let rough_data = dir.join(format!("data/{ROUGHNESS}"));
     (ctx.log)(format!(

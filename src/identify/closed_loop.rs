@@ -158,7 +158,7 @@ pub fn validate(
     }
     let mut plan = plan.clone();
     for c in &mut plan.conditions {
-        c.seeds = vec![seed];
+        c.only_seeds(&[seed]);
     }
     // The inputs at the noise the model was trained and tested with (its SNR and reference),
     // clean for a clean model.
