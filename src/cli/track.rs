@@ -45,6 +45,17 @@ pub fn run(args: TrackArgs) -> Result<()> {
             .write_csv(out, args.step)
             .with_context(|| format!("exporting {} every --step m", args.file.display()))?;
         println!("wrote {} (every {} m)", out.display(), args.step);
+        if let Some(w) = &track.spec().short_waves {
+            let shortest = w.shortest_wavelength();
+            if args.step > 0.25 * shortest {
+                println!(
+                    "note: the rails' short waves reach {:.0} mm; every {} m reads them aliased: give --step {} or less",
+                    shortest * 1e3,
+                    args.step,
+                    0.25 * shortest
+                );
+            }
+        }
     }
     if args.psd {
         print_roughness(&track);
