@@ -111,6 +111,12 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         .stepping
         .step_on(track.spec(), &vehicle, cfg.speed)?;
     let dt = cfg.dt;
+    if dt < request.stepping.dt
+        && let Some((_, why)) =
+            railforce::sim::Stepping::limit_on(track.spec(), &vehicle, cfg.speed)
+    {
+        eprintln!("note: step {:.4} ms: {why}", dt * 1e3);
+    }
     cfg.train = railforce::sim::hitch::TrainSetup::resolve(
         &args.consist,
         args.position,
