@@ -488,3 +488,49 @@ fn demo_runs_from_an_empty_folder() {
     assert!(links >= 20, "{links} links");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A step too coarse for the wheel–rail contact makes the wheel jump off its rail at once:
+/// the run stops naming it a jump and the step, not a flange climb; and a step given coarser
+/// than short waves allow is refused with the step that follows them.
+#[test]
+fn a_burst_is_named_and_a_step_too_coarse_for_short_waves_refused() {
+    let out = std::env::temp_dir().join(format!("railforce-burst-{}.csv", std::process::id()));
+    let out = out.to_str().unwrap();
+    let (ok, _, err) = railforce(&[
+        "simulate",
+        "--track",
+        "tangent",
+        "--speed-kmh",
+        "80",
+        "--duration",
+        "1",
+        "--dt",
+        "1e-3",
+        "--out",
+        out,
+    ]);
+    assert!(
+        !ok && err.contains("a jump") && err.contains("finer --dt"),
+        "{err}"
+    );
+    let (ok, _, err) = railforce(&[
+        "simulate",
+        "--track",
+        "tangent",
+        "--speed-kmh",
+        "80",
+        "--duration",
+        "1",
+        "--dt",
+        "5e-4",
+        "--roughness",
+        "cnossos_m",
+        "--out",
+        out,
+    ]);
+    assert!(
+        !ok && err.contains("too coarse") && err.contains("0.0625 ms"),
+        "{err}"
+    );
+    assert!(!std::path::Path::new(out).exists(), "nothing written");
+}
