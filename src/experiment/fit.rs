@@ -1,5 +1,6 @@
 //! The experiments' trainings: one model per job, as many at a time as the options allow, an
-//! ensemble's members as jobs of their own.
+//! ensemble's members as jobs of their own; and the reuse of a model an earlier run left on the
+//! same data and protocol.
 
 use super::Ctx;
 use crate::dataset::DataSet;
@@ -152,4 +153,39 @@ pub(super) struct FitJob<'d> {
     /// Added to the training seed (0: the experiments' seed; 1: a second training of the
     /// same model, for the spread over seeds).
     pub(super) seed_offset: u64,
+}
+
+/// The model an earlier run of the experiments left in `dir` (the generalisation's or the
+/// sensors' CNN-BiLSTM), when it was trained on the same data under the same protocol
+/// (`channels`, or its own; windows of `window` steps) and calibrated with its envelope:
+/// reused, not trained again.
+pub(super) fn earlier(
+    ctx: &Ctx,
+    dir: &Path,
+    ds: &DataSet,
+    channels: Option<&[String]>,
+    window: usize,
+) -> Option<Model> {
+    let m = Model::load(dir).ok()?;
+    let channels = channels.map_or_else(|| m.meta.data.channels.clone(), |c| c.to_vec());
+    let mut spec = ctx
+        .spec_windowed(
+            ds,
+            &channels,
+            &ctx.labels(),
+            NoiseProtocol::Matched,
+            ctx.split.clone(),
+            window,
+        )
+        .ok()?;
+    // The noise the experiments train with (`ds` may be the clean data).
+    spec.noise_model = Some(ctx.opts.noise(ctx.opts.snr_db));
+    let same = m.meta.kind == ModelKind::CnnBiLstm
+        && m.meta.data == spec
+        && m.meta.data_identity["data_fnv1a"].as_str() == Some(ctx.data_hash.as_str())
+        && m.meta
+            .calibration
+            .as_ref()
+            .is_some_and(|c| !c.envelope.is_empty());
+    same.then_some(m)
 }

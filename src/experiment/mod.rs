@@ -11,7 +11,7 @@
 mod assessment;
 mod comparison;
 mod fit;
-use fit::FitJob;
+use fit::{FitJob, earlier};
 mod generalization;
 mod index;
 mod mismatch;
@@ -337,41 +337,6 @@ impl Ctx<'_> {
                 .unwrap_or_else(|| "none (clean inputs)".into())
         )
     }
-}
-
-/// The model an earlier run of the experiments left in `dir` (the generalisation's or the
-/// sensors' CNN-BiLSTM), when it was trained on the same data under the same protocol
-/// (`channels`, or its own; windows of `window` steps) and calibrated with its envelope:
-/// reused, not trained again.
-fn earlier(
-    ctx: &Ctx,
-    dir: &Path,
-    ds: &DataSet,
-    channels: Option<&[String]>,
-    window: usize,
-) -> Option<Model> {
-    let m = Model::load(dir).ok()?;
-    let channels = channels.map_or_else(|| m.meta.data.channels.clone(), |c| c.to_vec());
-    let mut spec = ctx
-        .spec_windowed(
-            ds,
-            &channels,
-            &ctx.labels(),
-            NoiseProtocol::Matched,
-            ctx.split.clone(),
-            window,
-        )
-        .ok()?;
-    // The noise the experiments train with (`ds` may be the clean data).
-    spec.noise_model = Some(ctx.opts.noise(ctx.opts.snr_db));
-    let same = m.meta.kind == ModelKind::CnnBiLstm
-        && m.meta.data == spec
-        && m.meta.data_identity["data_fnv1a"].as_str() == Some(ctx.data_hash.as_str())
-        && m.meta
-            .calibration
-            .as_ref()
-            .is_some_and(|c| !c.envelope.is_empty());
-    same.then_some(m)
 }
 
 /// Simulates `plan` (clean, NPZ, 3 s settling) into `dir`, resuming what is there.
