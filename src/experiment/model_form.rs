@@ -246,7 +246,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
                 beams.name
             ),
             format!(
-                "Both also tested on short waves no training run had: the test runs again on the lumped track with {ROUGHNESS} rail roughness below the irregularities ({}: CNOSSOS-EU's average network from 1 m down to 0.1 m through the contact filter, 62.5 µs; physics.md §3.4).",
+                "Both also tested on short waves no training run had: the test runs again on the lumped track with {ROUGHNESS} rail roughness below the irregularities ({}: CNOSSOS-EU's average network from where the irregularities stop down to 0.1 m, through the contact filter, 62.5 µs; physics.md §3.4).",
                 rough.name
             ),
             format!(
@@ -259,7 +259,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
             ),
             ctx.protocol(&ctx.split, Some(opts.snr_db)),
             format!(
-                "Time: simulation on sleepers {sim_s:.0} s, trainings {train_s:.0} s ({} network{}); the part {:.0} s.",
+                "Time: simulation on sleepers and with roughness {sim_s:.0} s, trainings {train_s:.0} s ({} network{}); the part {:.0} s.",
                 jobs.len(),
                 if jobs.len() == 1 { "" } else { "s" },
                 t0.elapsed().as_secs_f64()

@@ -192,6 +192,9 @@ pub fn roughness_bands(w: &super::short_wave::ShortWaves, length: f64) -> Vec<Ba
         // The grid starts two steps before the track.
         let first = 2;
         let n = (crate::bounds::to_count((length / dx).floor())).min(x.len() - first);
+        if n < 16 {
+            continue;
+        }
         let mut buf: Vec<Complex64> = x[first..first + n]
             .iter()
             .map(|&v| Complex64::new(v, 0.0))
@@ -201,9 +204,16 @@ pub fn roughness_bands(w: &super::short_wave::ShortWaves, length: f64) -> Vec<Ba
         for &lambda in &centres {
             let kc = 1.0 / lambda;
             let (lo, hi) = (kc * 10f64.powf(-0.05), kc * 10f64.powf(0.05));
-            let power: f64 = (1..n / 2)
+            let bins: Vec<usize> = (1..n / 2)
                 .filter(|&i| (lo..hi).contains(&(i as f64 * dk)))
-                .map(|i| 2.0 * buf[i].norm_sqr() / (n * n) as f64)
+                .collect();
+            // A band narrower than the track's frequency step holds no bin: nothing to read.
+            if bins.is_empty() {
+                continue;
+            }
+            let power: f64 = bins
+                .iter()
+                .map(|&i| 2.0 * buf[i].norm_sqr() / (n * n) as f64)
                 .sum();
             let filter = if r.contact_filter {
                 super::short_wave::contact_filter_db(lambda)

@@ -52,7 +52,8 @@ impl Flat {
     /// a turn), m.
     fn radius_change(&self, u: f64, radius: f64) -> f64 {
         match self.rounded {
-            None if u.abs() <= 0.5 * self.length => -self.depth + u * u / (2.0 * radius),
+            // A chord; a depth given under the chord's leaves the flat shorter, never proud.
+            None if u.abs() <= 0.5 * self.length => (-self.depth + u * u / (2.0 * radius)).min(0.0),
             Some(lr) if u.abs() <= 0.5 * lr => {
                 -0.5 * self.depth * (1.0 + (2.0 * PI * u / lr).cos())
             }
@@ -81,7 +82,7 @@ impl WheelDefect {
     /// A wheel of nominal radius `radius` (m) with a flat and a polygon, its path computed.
     pub fn new(wheel: usize, flat: Option<Flat>, polygon: Option<(u32, f64)>, radius: f64) -> Self {
         let turn = 2.0 * PI * radius;
-        let n = (turn / PATH_STEP).round() as usize;
+        let n = ((turn / PATH_STEP).round() as usize).max(16);
         let h = turn / n as f64;
         // The tread's radius change at every grid point of one turn (the flat's centre at 0).
         let dr: Vec<f64> = (0..n)
@@ -117,7 +118,9 @@ impl WheelDefect {
     }
 
     /// How far the wheel's centre is lowered (≤ 0 over a flat) and its rate per metre rolled,
-    /// after `rolled` metres (the flat's centre and the polygon's first peak at the start).
+    /// after `rolled` metres (the flat's centre and the polygon's first peak at 0). A run passes
+    /// the wheelset's track position, so the flat strikes at every 2πR along the track, from
+    /// the start: out-of-roundness is not faded in as the rails' short waves are.
     pub fn radius_change(&self, rolled: f64) -> (f64, f64) {
         let n = self.path.len() - 3;
         let turn = 2.0 * PI * self.radius;
@@ -302,6 +305,22 @@ mod tests {
                 "at {s}: {fd}"
             );
         }
+    }
+
+    #[test]
+    fn a_new_flat_shallower_than_its_chord_never_stands_proud() {
+        let f = Flat {
+            length: 0.05,
+            depth: 0.3e-3,
+            rounded: None,
+        };
+        for i in 0..=100 {
+            let u = -0.025 + i as f64 * 5e-4;
+            assert!(f.radius_change(u, 0.42) <= 0.0, "{u}");
+        }
+        let d = WheelDefect::new(0, Some(f), None, 0.42);
+        assert!((d.radius_change(0.0).0 + 0.3e-3).abs() < 1e-6);
+        assert!(d.radius_change(0.03).0 <= 1e-12);
     }
 
     fn rows(text: &str) -> Result<Vec<WheelDefect>> {

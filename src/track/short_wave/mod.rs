@@ -196,6 +196,14 @@ impl super::TrackSpec {
         let geometry = self
             .irregularity
             .map(|i| (i.min_wavelength, i.seed, i.smooth_start, i.fade_in));
+        let shortest = DEFAULT_MIN_WAVELENGTH.min(0.5 * geometry.map_or(1.0, |g| g.0));
+        if spectrum.is_some() && self.length() / (shortest / POINTS_PER_WAVELENGTH) > MAX_SAMPLES {
+            return Err(crate::error::Error::Domain(format!(
+                "roughness on track '{}': {shortest} m waves over {:.0} m need more than {MAX_SAMPLES:.0} samples per rail: use a shorter track",
+                self.name,
+                self.length()
+            )));
+        }
         self.short_waves = with_roughness(self.short_waves, spectrum, geometry);
         Ok(())
     }
@@ -262,7 +270,9 @@ pub(super) fn from_file(
                     ),
                 )
             })?;
-            let min = r.min_wavelength_m.unwrap_or(DEFAULT_MIN_WAVELENGTH);
+            let min = r
+                .min_wavelength_m
+                .unwrap_or(DEFAULT_MIN_WAVELENGTH.min(0.5 * geo_min));
             if !(min.is_finite() && (SHORTEST_WAVELENGTH..1.0).contains(&min)) {
                 return Err(err(
                     "roughness.min_wavelength_m",
