@@ -420,38 +420,23 @@ impl Plan {
                     ));
                 }
             };
-            let rail_support = c.rail_support.clone().or_else(|| raw.rail_support.clone());
-            if let Some(m) = &rail_support
-                && !crate::track::RAIL_SUPPORT_MODELS.contains(&m.as_str())
-            {
-                return Err(Error::config(
-                    path,
-                    if c.rail_support.is_some() {
-                        f("rail_support")
-                    } else {
-                        "rail_support".into()
-                    },
-                    format!("{m:?}: give one of {:?}", crate::track::RAIL_SUPPORT_MODELS),
-                ));
-            }
-            let roughness = c.roughness.clone().or_else(|| raw.roughness.clone());
-            if let Some(r) = &roughness
-                && r != "none"
-                && crate::track::short_wave::RoughnessSpectrum::parse(r).is_none()
-            {
-                return Err(Error::config(
-                    path,
-                    if c.roughness.is_some() {
-                        f("roughness")
-                    } else {
-                        "roughness".into()
-                    },
-                    format!(
-                        "{r:?}: give \"none\" or one of {:?}",
-                        crate::track::short_wave::RoughnessSpectrum::NAMES
-                    ),
-                ));
-            }
+            let rail_support = track_choice(
+                path,
+                (&c.rail_support, &raw.rail_support),
+                (f("rail_support"), "rail_support"),
+                |m| crate::track::RAIL_SUPPORT_MODELS.contains(&m),
+                &format!("one of {:?}", crate::track::RAIL_SUPPORT_MODELS),
+            )?;
+            let roughness = track_choice(
+                path,
+                (&c.roughness, &raw.roughness),
+                (f("roughness"), "roughness"),
+                |r| r == "none" || crate::track::short_wave::RoughnessSpectrum::parse(r).is_some(),
+                &format!(
+                    "\"none\" or one of {:?}",
+                    crate::track::short_wave::RoughnessSpectrum::NAMES
+                ),
+            )?;
             let train = match &consist {
                 Some(name) => crate::sim::hitch::TrainSetup::resolve(
                     name,
@@ -544,5 +529,29 @@ impl Plan {
             crate::vary::check(&self.source, c.subject(index), &c.vary, &mut tried)?;
         }
         Ok(())
+    }
+}
+
+/// What a condition chooses over its track file (`own`, else the plan's), checked by `ok`; an
+/// unknown value is refused naming the condition's key, or the plan's where it came from there.
+fn track_choice(
+    path: &Path,
+    (own, plan): (&Option<String>, &Option<String>),
+    (own_key, plan_key): (String, &str),
+    ok: impl Fn(&str) -> bool,
+    allowed: &str,
+) -> Result<Option<String>> {
+    let value = own.clone().or_else(|| plan.clone());
+    match &value {
+        Some(v) if !ok(v) => Err(Error::config(
+            path,
+            if own.is_some() {
+                own_key
+            } else {
+                plan_key.into()
+            },
+            format!("{v:?}: give {allowed}"),
+        )),
+        _ => Ok(value),
     }
 }

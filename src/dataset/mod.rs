@@ -280,23 +280,18 @@ pub fn generate(
         if mirrored {
             spec.mirror();
         }
+        let at = |key: &str, e: Error| {
+            Error::config(
+                &plan.source,
+                format!("condition {}.{key}", r.condition.name),
+                e.to_string(),
+            )
+        };
         if let Some(m) = &r.condition.rail_support {
-            spec.set_rail_model(m).map_err(|e| {
-                Error::config(
-                    &plan.source,
-                    format!("condition {}.rail_support", r.condition.name),
-                    e.to_string(),
-                )
-            })?;
+            spec.set_rail_model(m).map_err(|e| at("rail_support", e))?;
         }
         if let Some(name) = &r.condition.roughness {
-            spec.set_roughness(name).map_err(|e| {
-                Error::config(
-                    &plan.source,
-                    format!("condition {}.roughness", r.condition.name),
-                    e.to_string(),
-                )
-            })?;
+            spec.set_roughness(name).map_err(|e| at("roughness", e))?;
         }
         tracks.push(Prepared {
             spec,

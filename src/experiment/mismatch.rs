@@ -217,13 +217,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     let ts = Instant::now();
     for (name, p, part) in plans {
         let data = dir.join("data").join(name);
-        (ctx.log)(format!(
-            "simulating {} runs of {} into {} (resumable) …",
-            p.conditions.iter().map(|c| c.seeds.len()).sum::<usize>(),
-            p.name,
-            data.display()
-        ));
-        super::simulate(&p, &data, opts.jobs)?;
+        ctx.simulate_runs(&p, &data)?;
         let ds = DataSet::load(&data)?.subset(None, Some(&keep))?;
         let about = match name {
             "fleet" => format!(

@@ -306,6 +306,17 @@ impl Ctx<'_> {
         DataSpec::resolve(&req, ds)
     }
 
+    /// Simulates `plan` into `dir` (resumable), saying so first.
+    fn simulate_runs(&self, plan: &Plan, dir: &Path) -> Result<()> {
+        (self.log)(format!(
+            "simulating {} runs of {} into {} (resumable) …",
+            plan.conditions.iter().map(|c| c.seeds.len()).sum::<usize>(),
+            plan.name,
+            dir.display()
+        ));
+        simulate(plan, dir, self.opts.jobs)
+    }
+
     /// The paper's 21 inputs.
     fn paper21() -> Vec<String> {
         PAPER_CHANNELS.iter().map(|c| c.to_string()).collect()

@@ -97,18 +97,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     }
     let dir = opts.out.join("model_form");
     let data = dir.join("data/on_sleepers");
-    (ctx.log)(format!(
-        "simulating {} runs of {} into {} (resumable) …",
-        beams
-            .conditions
-            .iter()
-            .map(|c| c.seeds.len())
-            .sum::<usize>(),
-        beams.name,
-        data.display()
-    ));
     let ts = Instant::now();
-    super::simulate(&beams, &data, opts.jobs)?;
+    ctx.simulate_runs(&beams, &data)?;
     let test_seeds = match &ctx.split {
         crate::features::Split::Seeds { test, .. } => test.clone(),
         _ => plan
@@ -124,17 +114,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         c.only_seeds(&test_seeds);
     }
     let rough_data = dir.join(format!("data/{ROUGHNESS}"));
-    (ctx.log)(format!(
-        "simulating {} runs of {} into {} (resumable) …",
-        rough
-            .conditions
-            .iter()
-            .map(|c| c.seeds.len())
-            .sum::<usize>(),
-        rough.name,
-        rough_data.display()
-    ));
-    super::simulate(&rough, &rough_data, opts.jobs)?;
+    ctx.simulate_runs(&rough, &rough_data)?;
     let sim_s = ts.elapsed().as_secs_f64();
     let paper = Ctx::paper21();
     let labels = ctx.labels();
