@@ -86,8 +86,9 @@ enum What {
         restrained: PathBuf,
     },
     /// Rails on discrete sleepers against closed forms (physics.md §3.3): a static load and
-    /// two loads against the Winkler beam, a load moving at 100 km/h, the receptance's peaks
-    /// against the cut-on frequencies. Exits non-zero on a miss.
+    /// two loads against the Winkler beam (the rails as Euler–Bernoulli beams), a load moving
+    /// at 100 km/h, the receptance's peaks against the cut-on frequencies and, at mid-span,
+    /// against the rail's pinned–pinned frequency. Exits non-zero on a miss.
     Track {
         /// Track file whose `[rail_support.discrete]` is checked [default: the default set].
         #[arg(long)]

@@ -1,17 +1,22 @@
 //! The discrete track's state and step, one wavenumber at a time.
 //!
 //! With identical sleepers at every interior fastener of the window, ballast shear between
-//! neighbours and everything at rest beyond the window's ends, every field of the track (each
-//! rail's vertical and lateral deflection at the fasteners, the sleepers' motion, the ballast
-//! blocks') is a sum of the same sines `sin(kπj/N)`, k = 1 … N−1, and the sines do not mix:
-//! the track falls apart into N−1 independent small systems, one per wavenumber, of six
-//! vertical degrees of freedom (the two rails' amplitudes, the sleepers' bounce and roll, the
-//! two ballast blocks') and three lateral (the two rails, the sleepers' sway). A rail's modal
-//! coordinate `q_k` of `φ_k = √(2/mL)·sin(kπx/L)` is its amplitude at the fasteners divided
-//! by `√(2/mL)`, so the rail's amplitude behaves as a mass `m·s` per fastener with the bending
-//! stiffness `s·EI·(kπ/L)⁴` of its mode; the ballast's shear adds `2·k_w·(1 − cos(kπ/N))` to
-//! each block. A wheel's force `P` at `x` enters each amplitude as `(2/N)·sin(kπx/L)·P` and
-//! the rail's deflection there is `Σ_k a_k·sin(kπx/L)`.
+//! neighbours and everything at rest beyond the window's ends, every field of the track is a
+//! sum of the same sines `sin(kπj/N)`, and the sines do not mix except by aliasing: at the
+//! fasteners the rail's wavenumber `2N − k` reads as `−sin(kπj/N)`. The rail carries the
+//! wavenumbers 1 … 2N − 1 (half a bay its shortest half-wave, so it bends between the
+//! sleepers), the sleepers and the ballast 1 … N − 1. The track falls apart into N − 1
+//! independent small systems, one per wavenumber k, of eight vertical degrees of freedom (the
+//! two rails' amplitudes of k and of 2N − k, the sleepers' bounce and roll, the two ballast
+//! blocks') and five lateral (the rails' two amplitudes each, the sleepers' sway), and the
+//! pinned–pinned modes (k = N, nodes at every fastener: no pad reaches them), one per rail and
+//! direction. A rail's modal coordinate `q_k` of `φ_k = √(2/mL)·sin(kπx/L)` is its amplitude
+//! divided by `√(2/mL)`, so the amplitude behaves as a mass `m_k·s` per fastener with the
+//! bending stiffness `s·m_k·ω_k²` of its free wave ([`super::DiscreteSupport::bending`]:
+//! Timoshenko's flexural branch, or Euler–Bernoulli's `EI·κ⁴`); a pad stretches by the
+//! difference of the two amplitudes; the ballast's shear adds `2·k_w·(1 − cos(kπ/N))` to each
+//! block. A wheel's force `P` at `x` enters each amplitude as `(2/N)·sin(kπx/L)·P` and the
+//! rail's deflection there is `Σ_k a_k·sin(kπx/L)`.
 //!
 //! Each system steps as the vehicle's wheelsets do, symplectic Euler with its springs and
 //! dampers shared into the step's end, its inverse built once per step length:
@@ -24,10 +29,10 @@
 //! ω·Δt = 2.45, no numerical damping); the damping `C` takes θ = ½. The trapezoidal rule's
 //! displacement `Δt·(v + Δv/2)` is not the one the wheel's solve takes for the rail, and burst.
 //! The nodal fields are needed only when the window shifts by whole bays (every 0.6 m of
-//! travel): the sines' transform and its inverse, exact.
+//! travel): the sines' transform and its inverse, exact (the rails' at every half bay).
 
 use super::DiscreteSupport;
-use nalgebra::{SVector, Vector3, Vector6};
+use nalgebra::{SVector, Vector2};
 
 /// Left and right rail (track y positive to the left): the sign of a rail seat's lever
 /// about the sleeper's centre.
@@ -90,9 +95,9 @@ impl<const D: usize> System<D> {
     }
 
     /// The rails' own stiffness (their diagonal in `k`: the pads' rail side) moved into the
-    /// backward-Euler part beside their bending.
-    fn rails_backward_euler(&mut self) {
-        for side in RAIL {
+    /// backward-Euler part beside their bending (`fold`: the folded modes' first index).
+    fn rails_backward_euler(&mut self, fold: usize) {
+        for side in [0, 1, fold, fold + 1] {
             self.bend[side] += self.k[(side, side)];
             self.k[(side, side)] = 0.0;
         }
@@ -134,30 +139,41 @@ impl<const D: usize> Default for State<D> {
     }
 }
 
-/// Vertical degrees of freedom: rails (left, right), sleeper bounce and roll, ballast (left,
-/// right). Lateral: rails (left, right), sleeper sway.
+/// The rails' (left, right) first degrees of freedom in either direction.
 const RAIL: [usize; 2] = [0, 1];
 
-/// One direction of the track (lateral, `D` = 3, or vertical, 6): every wavenumber's system
-/// and state.
+/// One direction of the track (lateral, `D` = 5, or vertical, 8): every wavenumber's system
+/// and state, and the rails' pinned–pinned modes (wavenumber N, nodes at every fastener: no
+/// pad moves them, so they stand alone, one per rail).
 #[derive(Debug, Clone)]
 struct Direction<const D: usize> {
     systems: Vec<System<D>>,
     states: Vec<State<D>>,
+    /// The rails' folded modes' degrees of freedom (`2N − k` beside `k`).
+    fold: usize,
+    pinned: System<2>,
+    pinned_state: State<2>,
 }
 
 impl<const D: usize> Direction<D> {
-    fn new(systems: Vec<System<D>>) -> Self {
+    fn new(systems: Vec<System<D>>, fold: usize, pinned: System<2>) -> Self {
         let states = vec![State::default(); systems.len()];
-        Direction { systems, states }
+        Direction {
+            systems,
+            states,
+            fold,
+            pinned,
+            pinned_state: State::default(),
+        }
     }
 
-    /// Rail `r`'s displacement and velocity at the point whose sines are `sines`.
-    fn point(&self, sines: &[f64], r: usize) -> (f64, f64) {
-        let (mut x, mut v) = (0.0, 0.0);
-        for (sn, st) in sines.iter().zip(&self.states) {
-            x += sn * st.x[r];
-            v += sn * st.v[r];
+    /// Rail `r`'s displacement and velocity at the point whose sines are `s`.
+    fn point(&self, s: &Sines, r: usize) -> (f64, f64) {
+        let (f, pp) = (self.fold + r, &self.pinned_state);
+        let (mut x, mut v) = (s.pinned * pp.x[r], s.pinned * pp.v[r]);
+        for ((a, b), st) in s.low.iter().zip(&s.high).zip(&self.states) {
+            x += a * st.x[r] + b * st.x[f];
+            v += a * st.v[r] + b * st.v[f];
         }
         (x, v)
     }
@@ -166,23 +182,42 @@ impl<const D: usize> Direction<D> {
         for (st, sys) in self.states.iter_mut().zip(&self.systems) {
             st.dv = sys.from_x * st.x + sys.from_v * st.v;
         }
+        let (st, sys) = (&mut self.pinned_state, &self.pinned);
+        st.dv = sys.from_x * st.x + sys.from_v * st.v;
     }
 
-    /// Rail `r`'s velocity change so far and its mobility at the point of `sines`; `g` is
-    /// `2/N`.
-    fn free(&self, sines: &[f64], r: usize, g: f64) -> (f64, f64) {
-        let (mut dv, mut w) = (0.0, 0.0);
-        for ((sn, st), sys) in sines.iter().zip(&self.states).zip(&self.systems) {
-            dv += sn * st.dv[r];
-            w += g * sn * sn * sys.inv[(r, r)];
+    /// Rail `r`'s velocity change so far and its mobility at the point of `s`; `g` is `2/N`.
+    fn free(&self, s: &Sines, r: usize, g: f64) -> (f64, f64) {
+        let f = self.fold + r;
+        let (pp, pi) = (&self.pinned_state, &self.pinned.inv);
+        let (mut dv, mut w) = (s.pinned * pp.dv[r], g * s.pinned * s.pinned * pi[(r, r)]);
+        for (((a, b), st), sys) in s
+            .low
+            .iter()
+            .zip(&s.high)
+            .zip(&self.states)
+            .zip(&self.systems)
+        {
+            dv += a * st.dv[r] + b * st.dv[f];
+            let i = &sys.inv;
+            w += g * (a * a * i[(r, r)] + a * b * (i[(r, f)] + i[(f, r)]) + b * b * i[(f, f)]);
         }
         (dv, w)
     }
 
-    /// An impulse on rail `r` at the point of `sines`, `g` its `2/N` share.
-    fn impulse(&mut self, sines: &[f64], r: usize, g: f64) {
-        for ((sn, st), sys) in sines.iter().zip(&mut self.states).zip(&self.systems) {
-            st.dv += sys.inv.column(r) * (g * sn);
+    /// An impulse on rail `r` at the point of `s`, `g` its `2/N` share.
+    fn impulse(&mut self, s: &Sines, r: usize, g: f64) {
+        let f = self.fold + r;
+        let pp = &mut self.pinned_state;
+        pp.dv += self.pinned.inv.column(r) * (g * s.pinned);
+        for (((a, b), st), sys) in s
+            .low
+            .iter()
+            .zip(&s.high)
+            .zip(&mut self.states)
+            .zip(&self.systems)
+        {
+            st.dv += sys.inv.column(r) * (g * a) + sys.inv.column(f) * (g * b);
         }
     }
 
@@ -191,18 +226,70 @@ impl<const D: usize> Direction<D> {
             st.v += st.dv;
             st.x += st.v * dt;
         }
+        let pp = &mut self.pinned_state;
+        pp.v += pp.dv;
+        pp.x += pp.v * dt;
     }
 
-    /// Every field moved by `moved` (amplitudes in, amplitudes out).
-    fn shift(&mut self, moved: &impl Fn(Vec<f64>) -> Vec<f64>) {
-        for d in 0..D {
-            let x = moved(self.states.iter().map(|st| st.x[d]).collect());
-            let v = moved(self.states.iter().map(|st| st.v[d]).collect());
-            for ((st, x), v) in self.states.iter_mut().zip(x).zip(v) {
-                (st.x[d], st.v[d]) = (x, v);
+    /// Every field moved: the sleepers' and the ballast's by `at_fasteners` (N − 1
+    /// amplitudes in and out), each rail's by `at_half_bays` (2N − 1: its wavenumbers
+    /// 1 … N − 1, N and the folded N + 1 … 2N − 1).
+    fn shift(
+        &mut self,
+        at_fasteners: &impl Fn(Vec<f64>) -> Vec<f64>,
+        at_half_bays: &impl Fn(Vec<f64>) -> Vec<f64>,
+    ) {
+        let n = self.states.len();
+        for d in (0..self.fold).filter(|d| !RAIL.contains(d)) {
+            for v in [false, true] {
+                let f = |st: &State<D>| if v { st.v[d] } else { st.x[d] };
+                let moved = at_fasteners(self.states.iter().map(f).collect());
+                for (st, m) in self.states.iter_mut().zip(moved) {
+                    *(if v { &mut st.v[d] } else { &mut st.x[d] }) = m;
+                }
+            }
+        }
+        for r in RAIL {
+            let f = self.fold + r;
+            for v in [false, true] {
+                let pick = |st: &State<D>, d: usize| if v { st.v[d] } else { st.x[d] };
+                let pp = if v {
+                    self.pinned_state.v[r]
+                } else {
+                    self.pinned_state.x[r]
+                };
+                let amps: Vec<f64> = (self.states.iter().map(|st| pick(st, r)))
+                    .chain(std::iter::once(pp))
+                    .chain(self.states.iter().rev().map(|st| pick(st, f)))
+                    .collect();
+                let moved = at_half_bays(amps);
+                for (k, m) in moved.into_iter().enumerate() {
+                    let (st, d) = match k.cmp(&n) {
+                        std::cmp::Ordering::Less => (&mut self.states[k], r),
+                        std::cmp::Ordering::Equal => {
+                            *(if v {
+                                &mut self.pinned_state.v[r]
+                            } else {
+                                &mut self.pinned_state.x[r]
+                            }) = m;
+                            continue;
+                        }
+                        std::cmp::Ordering::Greater => (&mut self.states[2 * n - k], f),
+                    };
+                    *(if v { &mut st.v[d] } else { &mut st.x[d] }) = m;
+                }
             }
         }
     }
+}
+
+/// `sin(kπx/L)` at one point for every wavenumber: `low` k = 1 … N − 1, `pinned` k = N,
+/// `high` the folded 2N − k beside each k of `low`.
+#[derive(Debug, Clone)]
+struct Sines {
+    low: Vec<f64>,
+    pinned: f64,
+    high: Vec<f64>,
 }
 
 /// The discrete track in its window.
@@ -211,16 +298,32 @@ pub struct TrackDynamics {
     p: DiscreteSupport,
     /// Along-track position of the window's start (a sleeper position), m.
     start: f64,
-    vertical: Direction<6>,
-    lateral: Direction<3>,
+    vertical: Direction<8>,
+    lateral: Direction<5>,
     /// The step the inverses were built for, s.
     dt: f64,
-    /// `sin(kπx/L)` at the last position asked for, k = 1 … N−1, and that position relative
-    /// to the window's start.
-    sines: Vec<f64>,
+    /// The sines at the last position asked for, and that position relative to the window's
+    /// start.
+    sines: Sines,
     sines_at: f64,
-    /// `sin(kπj/N)`, (N−1)², for the window's shifts.
+    /// `sin(kπj/N)`, (N−1)², and `sin(kπi/2N)`, (2N−1)², for the window's shifts.
     table: Vec<f64>,
+    table_half: Vec<f64>,
+}
+
+/// Vertical degrees of freedom: rails (left, right), sleeper bounce and roll, ballast (left,
+/// right), the rails' folded modes (left, right). Lateral: rails, sleeper sway, folded modes.
+const FOLD_VERTICAL: usize = 6;
+const FOLD_LATERAL: usize = 3;
+
+/// `sin((i+1)(j+1)π/n)` for i, j < n − 1.
+fn sine_table(n: usize) -> Vec<f64> {
+    let m = n - 1;
+    (0..m * m)
+        .map(|i| {
+            ((i / m + 1) as f64 * ((i % m) + 1) as f64 * std::f64::consts::PI / n as f64).sin()
+        })
+        .collect()
 }
 
 impl TrackDynamics {
@@ -229,56 +332,87 @@ impl TrackDynamics {
     pub fn new(p: DiscreteSupport, centre: f64) -> Self {
         let n = p.bays - 1;
         let nb = p.bays as f64;
-        let (b, ms) = (p.seat_half_distance, p.rail_mass * p.spacing);
+        let b = p.seat_half_distance;
+        // A rail mode of wavenumber k: its amplitude's mass and bending stiffness per fastener.
+        let mode = |k: usize, lateral: bool| {
+            let (m, kb) = p.bending(k as f64 * std::f64::consts::PI / p.window(), lateral);
+            (m * p.spacing, kb * p.spacing)
+        };
         let mut vertical = Vec::with_capacity(n);
         let mut lateral = Vec::with_capacity(n);
         for k in 1..=n {
-            let kappa4 = (k as f64 * std::f64::consts::PI / p.window()).powi(4);
             let shear = 2.0 * (1.0 - (k as f64 * std::f64::consts::PI / nb).cos());
-            let mut v = System::new(Vector6::new(
-                ms,
-                ms,
+            let ((ml, kl), (mh, kh)) = (mode(k, false), mode(2 * p.bays - k, false));
+            let mut v = System::new(SVector::<f64, 8>::from_column_slice(&[
+                ml,
+                ml,
                 p.sleeper_mass,
                 p.sleeper_roll_inertia,
                 p.ballast_mass,
                 p.ballast_mass,
-            ));
+                mh,
+                mh,
+            ]));
             for (side, sign) in SIDES.iter().enumerate() {
-                let unit = |i: usize| Vector6::from_fn(|r, _| if r == i { 1.0 } else { 0.0 });
+                let unit = |i: usize| SVector::<f64, 8>::from_fn(|r, _| f64::from(r == i));
                 let seat = unit(2) + unit(3) * (sign * b);
-                v.bend[side] = p.spacing * p.rail_ei_vertical * kappa4;
+                let rail = unit(side) - unit(FOLD_VERTICAL + side);
+                v.bend[side] = kl;
+                v.bend[FOLD_VERTICAL + side] = kh;
                 let (pad, bal) = (p.pad_vertical, p.ballast);
-                v.spring(unit(side) - seat, pad.stiffness, pad.damping);
+                v.spring(rail - seat, pad.stiffness, pad.damping);
                 v.spring(seat - unit(4 + side), bal.stiffness, bal.damping);
                 let (sg, sh) = (p.subgrade, p.ballast_shear);
                 v.spring(unit(4 + side), sg.stiffness, sg.damping);
                 v.spring(unit(4 + side), shear * sh.stiffness, shear * sh.damping);
             }
-            v.rails_backward_euler();
+            v.rails_backward_euler(FOLD_VERTICAL);
             vertical.push(v);
-            let mut l = System::new(Vector3::new(ms, ms, p.sleeper_mass));
+            let ((ml, kl), (mh, kh)) = (mode(k, true), mode(2 * p.bays - k, true));
+            let mut l = System::new(SVector::<f64, 5>::from_column_slice(&[
+                ml,
+                ml,
+                p.sleeper_mass,
+                mh,
+                mh,
+            ]));
             for side in 0..2 {
-                let rail = Vector3::from_fn(|r, _| if r == side { 1.0 } else { 0.0 });
-                l.bend[side] = p.spacing * p.rail_ei_lateral * kappa4;
+                let unit = |i: usize| SVector::<f64, 5>::from_fn(|r, _| f64::from(r == i));
+                let rail = unit(side) - unit(FOLD_LATERAL + side);
+                l.bend[side] = kl;
+                l.bend[FOLD_LATERAL + side] = kh;
                 let pad = p.pad_lateral;
-                l.spring(rail - Vector3::z(), pad.stiffness, pad.damping);
+                l.spring(rail - unit(2), pad.stiffness, pad.damping);
             }
             let sl = p.sleeper_lateral;
-            l.spring(Vector3::z(), sl.stiffness, sl.damping);
-            l.rails_backward_euler();
+            l.spring(
+                SVector::<f64, 5>::from_fn(|r, _| f64::from(r == 2)),
+                sl.stiffness,
+                sl.damping,
+            );
+            l.rails_backward_euler(FOLD_LATERAL);
             lateral.push(l);
         }
-        let table = (0..n * n)
-            .map(|i| ((i / n + 1) as f64 * ((i % n) + 1) as f64 * std::f64::consts::PI / nb).sin())
-            .collect();
+        // The pinned–pinned modes: bending alone (no pad reaches them).
+        let pinned = |lateral: bool| {
+            let (m, k) = mode(p.bays, lateral);
+            let mut s = System::new(Vector2::new(m, m));
+            s.bend = Vector2::new(k, k);
+            s
+        };
         TrackDynamics {
             start: ((centre - 0.5 * p.window()) / p.spacing).round() * p.spacing,
-            vertical: Direction::new(vertical),
-            lateral: Direction::new(lateral),
+            vertical: Direction::new(vertical, FOLD_VERTICAL, pinned(false)),
+            lateral: Direction::new(lateral, FOLD_LATERAL, pinned(true)),
             dt: 0.0,
-            sines: vec![0.0; n],
+            sines: Sines {
+                low: vec![0.0; n],
+                pinned: 0.0,
+                high: vec![0.0; n],
+            },
             sines_at: f64::NAN,
-            table,
+            table: sine_table(p.bays),
+            table_half: sine_table(2 * p.bays),
             p,
         }
     }
@@ -293,8 +427,8 @@ impl TrackDynamics {
         self.start
     }
 
-    /// `sin(kπx/L)` for every wavenumber at `s` (held inside the window) into `self.sines`,
-    /// by the Chebyshev recurrence.
+    /// `sin(kπx/L)` for every wavenumber k = 1 … 2N − 1 at `s` (held inside the window) into
+    /// `self.sines`, by the Chebyshev recurrence.
     fn sines_at(&mut self, s: f64) {
         let l = self.p.window();
         let x = (s - self.start).clamp(1e-6 * l, (1.0 - 1e-6) * l);
@@ -303,9 +437,14 @@ impl TrackDynamics {
         }
         self.sines_at = x;
         let a = std::f64::consts::PI * x / l;
+        let n = self.sines.low.len();
         let (c2, mut prev, mut cur) = (2.0 * a.cos(), 0.0, a.sin());
-        for p in self.sines.iter_mut() {
-            *p = cur;
+        for k in 0..2 * n + 1 {
+            match k.cmp(&n) {
+                std::cmp::Ordering::Less => self.sines.low[k] = cur,
+                std::cmp::Ordering::Equal => self.sines.pinned = cur,
+                std::cmp::Ordering::Greater => self.sines.high[2 * n - k] = cur,
+            }
             let next = c2 * cur - prev;
             prev = cur;
             cur = next;
@@ -330,29 +469,12 @@ impl TrackDynamics {
         }
         self.start += n * self.p.spacing;
         let shift = n as i64;
-        let (len, g) = (self.sines.len(), 2.0 / self.p.bays as f64);
-        let table = &self.table;
-        // One field's amplitudes to the fasteners, shifted, and back.
-        let moved = |amps: Vec<f64>| -> Vec<f64> {
-            let nodes: Vec<f64> = (0..len)
-                .map(|j| dot(&table[j * len..(j + 1) * len], &amps))
-                .collect();
-            let shifted: Vec<f64> = (0..len as i64)
-                .map(|j| {
-                    let i = j + shift;
-                    if (0..len as i64).contains(&i) {
-                        nodes[i as usize]
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            (0..len)
-                .map(|k| g * dot(&table[k * len..(k + 1) * len], &shifted))
-                .collect()
-        };
-        self.vertical.shift(&moved);
-        self.lateral.shift(&moved);
+        let bays = self.p.bays;
+        let (table, half) = (&self.table, &self.table_half);
+        let at_fasteners = |amps: Vec<f64>| moved(table, bays, shift, amps);
+        let at_half_bays = |amps: Vec<f64>| moved(half, 2 * bays, 2 * shift, amps);
+        self.vertical.shift(&at_fasteners, &at_half_bays);
+        self.lateral.shift(&at_fasteners, &at_half_bays);
     }
 
     /// Starts a step of `dt` s: every wavenumber's velocity change under its own springs and
@@ -361,6 +483,8 @@ impl TrackDynamics {
         if dt != self.dt {
             self.vertical.systems.iter_mut().for_each(|s| s.factor(dt));
             self.lateral.systems.iter_mut().for_each(|s| s.factor(dt));
+            self.vertical.pinned.factor(dt);
+            self.lateral.pinned.factor(dt);
             self.dt = dt;
         }
         self.vertical.begin();
@@ -413,6 +537,27 @@ impl TrackDynamics {
             self.step(dt, loads);
         }
     }
+}
+
+/// A field's amplitudes over the sines of `n` intervals (`table` their `n − 1` sines at the
+/// `n − 1` interior points), taken to the points, moved by `shift` points (what enters is at
+/// rest), and back: the sine transform is its own inverse up to `2/n`.
+fn moved(table: &[f64], n: usize, shift: i64, amps: Vec<f64>) -> Vec<f64> {
+    let len = n - 1;
+    let row = |j: usize| &table[j * len..(j + 1) * len];
+    let nodes: Vec<f64> = (0..len).map(|j| dot(row(j), &amps)).collect();
+    let shifted: Vec<f64> = (0..len as i64)
+        .map(|j| {
+            let i = j + shift;
+            if (0..len as i64).contains(&i) {
+                nodes[i as usize]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let g = 2.0 / n as f64;
+    (0..len).map(|k| g * dot(row(k), &shifted)).collect()
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {

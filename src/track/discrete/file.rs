@@ -1,7 +1,7 @@
 //! `[rail_support.discrete]` in a track file: every key optional, each defaulting to the
 //! parameter set of [`super::DiscreteSupport::default`].
 
-use super::{DiscreteSupport, KelvinVoigt};
+use super::{DiscreteSupport, KelvinVoigt, RailBeam};
 use crate::error::{Error, Result};
 use serde::Deserialize;
 use std::path::Path;
@@ -15,6 +15,11 @@ pub struct DiscreteFile {
     rail_mass_kg_per_m: Option<f64>,
     rail_ei_vertical_nm2: Option<f64>,
     rail_ei_lateral_nm2: Option<f64>,
+    rail_beam: Option<String>,
+    rail_shear_stiffness_vertical_n: Option<f64>,
+    rail_shear_stiffness_lateral_n: Option<f64>,
+    rail_rotary_inertia_vertical_kgm: Option<f64>,
+    rail_rotary_inertia_lateral_kgm: Option<f64>,
     pad_vertical_stiffness_n_per_m: Option<f64>,
     pad_vertical_damping_ns_per_m: Option<f64>,
     pad_lateral_stiffness_n_per_m: Option<f64>,
@@ -55,6 +60,18 @@ impl DiscreteFile {
                 format!("must be 16 to 512 bays, got {bays}"),
             ));
         }
+        let rail_beam = match self.rail_beam.as_deref() {
+            None => d.rail_beam,
+            Some("timoshenko") => RailBeam::Timoshenko,
+            Some("euler_bernoulli") => RailBeam::EulerBernoulli,
+            Some(other) => {
+                return Err(Error::config(
+                    path,
+                    "rail_support.discrete.rail_beam",
+                    format!("must be \"timoshenko\" or \"euler_bernoulli\", got \"{other}\""),
+                ));
+            }
+        };
         let p = DiscreteSupport {
             spacing: get(
                 "sleeper_spacing_m",
@@ -80,6 +97,31 @@ impl DiscreteFile {
                 self.rail_ei_lateral_nm2,
                 d.rail_ei_lateral,
                 false,
+            )?,
+            rail_beam,
+            rail_shear_vertical: get(
+                "rail_shear_stiffness_vertical_n",
+                self.rail_shear_stiffness_vertical_n,
+                d.rail_shear_vertical,
+                false,
+            )?,
+            rail_shear_lateral: get(
+                "rail_shear_stiffness_lateral_n",
+                self.rail_shear_stiffness_lateral_n,
+                d.rail_shear_lateral,
+                false,
+            )?,
+            rail_rotary_vertical: get(
+                "rail_rotary_inertia_vertical_kgm",
+                self.rail_rotary_inertia_vertical_kgm,
+                d.rail_rotary_vertical,
+                true,
+            )?,
+            rail_rotary_lateral: get(
+                "rail_rotary_inertia_lateral_kgm",
+                self.rail_rotary_inertia_lateral_kgm,
+                d.rail_rotary_lateral,
+                true,
             )?,
             pad_vertical: kv(
                 "pad_vertical_stiffness_n_per_m",

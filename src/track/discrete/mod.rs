@@ -1,22 +1,23 @@
 //! Rails as beams on discrete sleepers (`[rail_support] model = "discrete"`): the coupled
 //! vehicle–track model of Zhai's school, in a window of track that moves with the vehicle.
 //!
-//! Per rail, a vertical and a lateral Euler–Bernoulli beam, simply supported at the window's
-//! ends, in modal coordinates (`φ_k(x) = √(2/(m·L))·sin(kπx/L)`, one mode per fastener). Each
-//! fastener is a rail pad (vertical and lateral spring and damper) to a rigid sleeper (vertical,
-//! lateral and roll); under each rail seat a ballast block on the subgrade, coupled to its
-//! neighbours in shear. With the fasteners evenly spaced and as many modes as fasteners the
-//! modes' values at the fasteners are a discrete sine transform (DST-I), and so are the
-//! sleepers' and the ballast's fields: the track steps one wavenumber at a time
-//! ([`TrackDynamics`]), and the window shifts by whole bays exactly.
+//! Per rail, a vertical and a lateral Timoshenko beam (or Euler–Bernoulli, `rail_beam`), simply
+//! supported at the window's ends, in modal coordinates (`φ_k(x) = √(2/(m·L))·sin(kπx/L)`, two
+//! modes per fastener and the pinned–pinned mode, so the rail bends between the sleepers).
+//! Each fastener is a rail pad (vertical and lateral spring and damper) to a rigid sleeper
+//! (vertical, lateral and roll); under each rail seat a ballast block on the subgrade, coupled
+//! to its neighbours in shear. With the fasteners evenly spaced the modes' values at the
+//! fasteners are a discrete sine transform (DST-I), and so are the sleepers' and the ballast's
+//! fields: the track steps one wavenumber at a time ([`TrackDynamics`]), and the window shifts
+//! by whole bays exactly.
 //!
 //! What the model leaves out (stated, not hidden):
-//! - **shear and rotary inertia** (Euler–Bernoulli): the pinned–pinned frequency would sit at
-//!   1.44 kHz for CHN60 on 0.6 m where a Timoshenko rail puts it near 1 kHz; the window's
-//!   modes stop at a wavelength of two bays, so the pinned–pinned mode itself is not carried
-//!   (the step's band ends at 600 Hz);
+//! - **the Timoshenko beam's second branch** (the shear wave, cut on near 6.7 kHz for CHN60)
+//!   and wavelengths under one bay: the rail's response ends near 2 kHz;
 //! - **rail roll** (torsion): the lateral beam is the rail head on the lateral pads, so the
 //!   lateral compliance lacks the roll part the lumped model lumps in;
+//! - **the pads' length**: a fastener is a point, so nothing damps the pinned–pinned mode but
+//!   the step (backward Euler on the rails' bending);
 //! - **the window's ends**: the rail is pinned there and the track beyond it is at rest
 //!   (the window reaches 14 m past the vehicle's centre; the basin decays as `e^(−β·x)`,
 //!   β ≈ 1.15 /m, so to 10⁻⁵ within it).
@@ -24,8 +25,11 @@
 //! Parameters: Zhai, Wang & Lin, "Modelling and experiment of railway ballast vibrations",
 //! J. Sound Vib. 270 (2004) 673–683 (rail, pads, sleepers, ballast, subgrade, vertical), and the
 //! lateral and shear set credited to Zhai's *Vehicle–Track Coupled Dynamics* (pad lateral,
-//! sleeper lateral, ballast shear, rail Iz); the sleeper's roll inertia and rail-seat distance
-//! are estimates.
+//! sleeper lateral, ballast shear, rail Iz); CHN60's section (77.45 cm², 3217 and 524 cm⁴) as
+//! tabled in Hindawi *Adv. Civ. Eng.* 2021, 8847633, Table 2, and *Shock Vib.* 2021, 5562152,
+//! Table 3, which gives the vertical shear coefficient 0.4; the lateral 0.54 is the UIC60
+//! figure of the rolland track model's rail table (an estimate for CHN60); the sleeper's roll
+//! inertia and rail-seat distance are estimates.
 
 mod checks;
 mod dynamics;
@@ -59,6 +63,16 @@ pub struct DiscreteSupport {
     pub rail_ei_vertical: f64,
     /// Rail bending stiffness for lateral bending (E·I_z), N·m².
     pub rail_ei_lateral: f64,
+    /// The rails' beam theory.
+    pub rail_beam: RailBeam,
+    /// Rail shear stiffness for vertical bending (κ·G·A), N (Timoshenko only).
+    pub rail_shear_vertical: f64,
+    /// Rail shear stiffness for lateral bending (κ·G·A), N (Timoshenko only).
+    pub rail_shear_lateral: f64,
+    /// Rail rotary inertia per length for vertical bending (ρ·I_y), kg·m (Timoshenko only).
+    pub rail_rotary_vertical: f64,
+    /// Rail rotary inertia per length for lateral bending (ρ·I_z), kg·m (Timoshenko only).
+    pub rail_rotary_lateral: f64,
     /// Rail pad, vertical (per fastener).
     pub pad_vertical: KelvinVoigt,
     /// Rail pad and fastening, lateral (per fastener).
@@ -81,17 +95,39 @@ pub struct DiscreteSupport {
     pub subgrade: KelvinVoigt,
 }
 
+/// The rails' beam theory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RailBeam {
+    /// Bending with shear deformation and rotary inertia (the flexural branch).
+    Timoshenko,
+    /// Bending alone: stiffer and lighter at short waves (pinned–pinned 1.44 kHz for CHN60 on
+    /// 0.6 m against Timoshenko's 1.07 kHz); the Winkler closed forms' beam.
+    EulerBernoulli,
+}
+
 impl Default for DiscreteSupport {
     /// Zhai, Wang & Lin 2004 for CHN60 on concrete sleepers and ballast (vertical), the
     /// lateral and shear figures of Zhai's book set; roll inertia and seat distance estimates.
     fn default() -> Self {
         const E: f64 = 2.059e11;
+        // CHN60: area 77.45 cm², I_y 3217 cm⁴, I_z 524 cm⁴ (the sources above); G = E/2(1 + ν)
+        // with ν = 0.3.
+        const AREA: f64 = 77.45e-4;
+        const G: f64 = E / 2.6;
+        const RHO: f64 = 60.64 / AREA;
         DiscreteSupport {
             spacing: 0.6,
             bays: 48,
             rail_mass: 60.64,
             rail_ei_vertical: E * 3.217e-5,
             rail_ei_lateral: E * 5.24e-6,
+            rail_beam: RailBeam::Timoshenko,
+            // Shear coefficients: 0.4 vertical (Shock Vib. 2021, 5562152, Table 3), 0.54
+            // lateral (rolland's UIC60 figure; an estimate for CHN60).
+            rail_shear_vertical: 0.4 * G * AREA,
+            rail_shear_lateral: 0.54 * G * AREA,
+            rail_rotary_vertical: RHO * 3.217e-5,
+            rail_rotary_lateral: RHO * 5.24e-6,
             pad_vertical: KelvinVoigt {
                 stiffness: 6.5e7,
                 damping: 7.5e4,
@@ -131,6 +167,54 @@ impl DiscreteSupport {
     /// The window's length, m.
     pub fn window(&self) -> f64 {
         self.spacing * self.bays as f64
+    }
+
+    /// The rails as Euler–Bernoulli beams (the closed forms' beam), the rest the same.
+    pub fn euler_bernoulli(&self) -> Self {
+        DiscreteSupport {
+            rail_beam: RailBeam::EulerBernoulli,
+            ..*self
+        }
+    }
+
+    /// A free rail's bending wave of wavenumber `kappa` (1/m), vertical or `lateral`: its
+    /// mass per length as the deflection sees it and its stiffness per length, `(m, k)`,
+    /// `k/m = ω²`. Timoshenko's flexural branch: the lower root of
+    /// `ρI·m·ω⁴ − (m(EIκ² + S) + ρI·Sκ²)·ω² + S·EI·κ⁴ = 0` (S = κ'GA), with the section's
+    /// rotation `ψ = (Sκ² − mω²)/(Sκ)·w` adding `ρI·(ψ/w)²` to the mass; Euler–Bernoulli:
+    /// `(m, EI·κ⁴)`.
+    pub fn bending(&self, kappa: f64, lateral: bool) -> (f64, f64) {
+        let (ei, s, r) = if lateral {
+            (
+                self.rail_ei_lateral,
+                self.rail_shear_lateral,
+                self.rail_rotary_lateral,
+            )
+        } else {
+            (
+                self.rail_ei_vertical,
+                self.rail_shear_vertical,
+                self.rail_rotary_vertical,
+            )
+        };
+        let (m, k2) = (self.rail_mass, kappa * kappa);
+        if self.rail_beam == RailBeam::EulerBernoulli {
+            return (m, ei * k2 * k2);
+        }
+        let b = m * (ei * k2 + s) + r * s * k2;
+        let c = s * ei * k2 * k2;
+        // The lower root, in the form that stays exact as ρI → 0.
+        let w2 = 2.0 * c / (b + (b * b - 4.0 * m * r * c).max(0.0).sqrt());
+        let psi = (s * k2 - m * w2) / (s * kappa);
+        let mass = m + r * psi * psi;
+        (mass, mass * w2)
+    }
+
+    /// The rail's pinned–pinned frequency, Hz: its bending wave of half a wavelength per bay
+    /// (nodes at every fastener), vertical or `lateral`.
+    pub fn pinned_pinned(&self, lateral: bool) -> f64 {
+        let (m, k) = self.bending(std::f64::consts::PI / self.spacing, lateral);
+        (k / m).sqrt() / (2.0 * std::f64::consts::PI)
     }
 
     /// Vertical stiffness of one rail seat's support chain (pad, ballast and subgrade in

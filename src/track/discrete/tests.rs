@@ -25,7 +25,7 @@ fn static_load_matches_the_winkler_beam() {
             stiffness: 0.0,
             damping: 0.0,
         },
-        ..DiscreteSupport::default()
+        ..DiscreteSupport::default().euler_bernoulli()
     };
     assert!((p.beta() - 1.154).abs() < 2e-3, "β = {}", p.beta());
     let load = 100e3;
@@ -77,7 +77,7 @@ fn two_loads_superpose() {
             stiffness: 0.0,
             damping: 0.0,
         },
-        ..p
+        ..p.euler_bernoulli()
     };
     let mut t = settled(p, 12.9, &both);
     for x in [12.0, 12.9, 13.83] {
@@ -155,7 +155,7 @@ fn released_track_comes_to_rest_at_the_default_step() {
 #[test]
 fn validate_track_checks_pass() {
     let c = checks(&DiscreteSupport::default());
-    assert_eq!(c.len(), 6);
+    assert_eq!(c.len(), 7);
     for check in &c {
         assert!(check.passes(), "{check:?}");
     }
@@ -181,10 +181,10 @@ fn file_errors_name_the_key() {
 
 /// The point receptance (both rails struck alike, from an impulse response at 0.02 ms): its
 /// first two peaks sit at the track's first two cut-on frequencies (derived from the rail
-/// seat's chain: 52 and 157 Hz for Zhai's 2004 set; measured 52 and 146 Hz, the second
+/// seat's chain: 52 and 157 Hz for Zhai's 2004 set; measured 52 and 144 Hz, the second
 /// lowered by the ballast's shear and the rail's bending), its low-frequency end at the static
-/// deflection per newton. Over a sleeper and at mid-span alike (within 1 % to 500 Hz): the
-/// pinned–pinned mode lies beyond the window's modes.
+/// deflection per newton (Timoshenko's shear adds 4 %). Over a sleeper and at mid-span alike
+/// within 3 % to 500 Hz, where the rail's waves are long against the bay.
 #[test]
 fn receptance_peaks_at_the_cut_on_frequencies() {
     let p = DiscreteSupport::default();
@@ -195,11 +195,7 @@ fn receptance_peaks_at_the_cut_on_frequencies() {
     );
     let over = receptance(p, 0.0, 2e-5, 0.5, 600.0);
     let mid = receptance(p, 0.5 * p.spacing, 2e-5, 0.5, 600.0);
-    let peaks: Vec<f64> = over
-        .windows(3)
-        .filter(|w| w[0].0 >= 10.0 && w[1].1 > w[0].1 && w[1].1 >= w[2].1)
-        .map(|w| w[1].0)
-        .collect();
+    let peaks = peaks(&over);
     assert!(peaks.len() >= 2, "{peaks:?}");
     for (peak, c) in peaks.iter().zip(cut) {
         assert!(
@@ -207,10 +203,52 @@ fn receptance_peaks_at_the_cut_on_frequencies() {
             "peak {peak} Hz against cut-on {c} Hz"
         );
     }
-    let at = |r: &[(f64, f64)], f: f64| r.iter().find(|x| x.0 >= f).unwrap().1;
     let statics = p.winkler_deflection(1.0, 0.0);
     assert!((at(&over, 10.0) / statics - 1.0).abs() < 0.1);
     for f in [20.0, 50.0, 144.0, 300.0, 500.0] {
-        assert!((at(&mid, f) / at(&over, f) - 1.0).abs() < 0.01, "{f} Hz");
+        assert!((at(&mid, f) / at(&over, f) - 1.0).abs() < 0.03, "{f} Hz");
     }
+}
+
+fn at(r: &[(f64, f64)], f: f64) -> f64 {
+    r.iter().find(|x| x.0 >= f).unwrap().1
+}
+
+fn peaks(r: &[(f64, f64)]) -> Vec<f64> {
+    r.windows(3)
+        .filter(|w| w[0].0 >= 10.0 && w[1].1 > w[0].1 && w[1].1 >= w[2].1)
+        .map(|w| w[1].0)
+        .collect()
+}
+
+/// The pinned–pinned resonance: at mid-span the receptance peaks at the rail's free bending
+/// wave of two bays (Timoshenko's 1073 Hz for CHN60 on 0.6 m, Euler–Bernoulli's 1442 Hz,
+/// within 1 %: the 0.02 ms step's own error reaches 0.4 % at 1.4 kHz), where over a sleeper
+/// the receptance is less than two thirds of it. The closed
+/// form at 0.65 m against the first stop bands a periodic-structure study of a rail on
+/// sleepers 0.65 m apart reports (J. Adv. Transp. 2021, 6635198, Table 2: 445.2–459.7 Hz and
+/// 962.5–1001.5 Hz): lateral and vertical within 5 % of the band.
+#[test]
+fn pinned_pinned_resonance_at_mid_span() {
+    let p = DiscreteSupport::default();
+    for (q, expected) in [(p, 1072.7), (p.euler_bernoulli(), 1442.1)] {
+        let f = q.pinned_pinned(false);
+        assert!((f - expected).abs() < 0.5, "{f} Hz against {expected}");
+        let over = receptance(q, 0.0, 2e-5, 0.5, 2000.0);
+        let mid = receptance(q, 0.5 * q.spacing, 2e-5, 0.5, 2000.0);
+        let near = peaks(&mid)
+            .into_iter()
+            .min_by(|a, b| (a - f).abs().total_cmp(&(b - f).abs()))
+            .unwrap();
+        assert!(
+            (near / f - 1.0).abs() < 0.01,
+            "mid-span peak {near} Hz against {f} Hz"
+        );
+        assert!(at(&mid, near) > 1.5 * at(&over, near), "{near} Hz");
+    }
+    let wide = DiscreteSupport { spacing: 0.65, ..p };
+    let band = |f: f64, lo: f64, hi: f64| f > 0.95 * lo && f < 1.05 * hi;
+    let (v, l) = (wide.pinned_pinned(false), wide.pinned_pinned(true));
+    assert!(band(v, 962.5, 1001.5), "vertical {v} Hz");
+    assert!(band(l, 445.2, 459.7), "lateral {l} Hz");
 }
