@@ -1,6 +1,6 @@
 //! Training and inference throughput of the networks (windows per second, one thread), with
-//! the spec's PyTorch reference figures (assets/docs/performance.md, "Learning engine") and this machine's sustained GEMM rate
-//! measured in the same run (the hardware reference the ratio is read against).
+//! this machine's sustained GEMM rate measured in the same run (the hardware reference), and
+//! PyTorch's in alternating rounds where it is installed (`torch.rs`).
 
 use railforce::learn::linalg::gemm;
 use railforce::learn::neural::{Adam, Architecture, NetConfig, Network};
@@ -16,23 +16,6 @@ pub struct NetBench {
     pub infer_windows_per_s: f64,
     /// Inference latency of one window, ms.
     pub single_ms: f64,
-    /// PyTorch 2.15 CPU one-thread training reference (assets/docs/performance.md, "Learning engine"), windows/s.
-    pub pytorch_train_reference: f64,
-}
-
-/// Spec §5 reference: PyTorch CNN-BiLSTM inference in batches of 64–1 024, windows/s.
-pub const PYTORCH_INFER_WINDOWS_PER_S: f64 = 40_000.0;
-/// Spec §5 reference: PyTorch CNN-BiLSTM inference of one window, ms.
-pub const PYTORCH_SINGLE_MS: f64 = 0.22;
-
-/// Spec §5 reference training rates (batch 64).
-pub fn pytorch_reference(a: Architecture) -> f64 {
-    match a {
-        Architecture::CnnBiLstm => 7_400.0,
-        Architecture::Cnn => 10_000.0,
-        Architecture::BiLstm => 38_000.0,
-        Architecture::Gru => 37_000.0,
-    }
 }
 
 /// Sustained single-thread GEMM rate, GFLOP/s, on the LSTM input projection's shape.
@@ -103,16 +86,10 @@ pub fn train_rate(
 pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
     let train = train_rate(architecture, GradientEngine::Fused, batch, seconds)
         .expect("the fused engine is always built");
+    let infer = infer_rate(architecture, seconds);
     let mut net = Network::new(bench_config(architecture));
     let per = 20 * 21;
-    let big = windows(1024);
-    let mut n = 0usize;
-    let t0 = Instant::now();
-    while t0.elapsed().as_secs_f64() < seconds || n == 0 {
-        std::hint::black_box(net.predict(&big, 1024));
-        n += 1024;
-    }
-    let infer = n as f64 / t0.elapsed().as_secs_f64();
+    let big = windows(1);
     let mut k = 0usize;
     let t0 = Instant::now();
     while t0.elapsed().as_secs_f64() < seconds / 2.0 || k == 0 {
@@ -123,8 +100,21 @@ pub fn run(architecture: Architecture, batch: usize, seconds: f64) -> NetBench {
         train_windows_per_s: train,
         infer_windows_per_s: infer,
         single_ms: t0.elapsed().as_secs_f64() * 1e3 / k as f64,
-        pytorch_train_reference: pytorch_reference(architecture),
     }
+}
+
+/// Inference windows per second of one architecture in batches of 1 024 for about `seconds`.
+pub fn infer_rate(architecture: Architecture, seconds: f64) -> f64 {
+    let mut net = Network::new(bench_config(architecture));
+    let big = windows(1024);
+    let mut n = 0usize;
+    std::hint::black_box(net.predict(&big, 1024));
+    let t0 = Instant::now();
+    while t0.elapsed().as_secs_f64() < seconds || n == 0 {
+        std::hint::black_box(net.predict(&big, 1024));
+        n += 1024;
+    }
+    n as f64 / t0.elapsed().as_secs_f64()
 }
 
 /// Training rates with gradients by burn (`engines`: `burn-cpu`, `burn-gpu`) for the four
@@ -140,36 +130,22 @@ pub fn burn_table(engines: &[String], batches: &[usize], seconds: f64) -> anyhow
         "training with gradients by burn 0.22 (21 channels × 20 steps; weights upload and gradients read back every step, Adam in the engine)"
     );
     println!(
-        "{:<11} {:>6} {:<10} {:>12} {:>15} {:>10} {:>22}",
-        "network",
-        "batch",
-        "engine",
-        "train win/s",
-        "fused win/s",
-        "vs fused",
-        "PyTorch CPU (performance.md)"
+        "{:<11} {:>6} {:<10} {:>12} {:>15} {:>10}",
+        "network", "batch", "engine", "train win/s", "fused win/s", "vs fused"
     );
     for a in [A::CnnBiLstm, A::Cnn, A::BiLstm, A::Gru] {
         for &batch in batches {
             let fused = train_rate(a, GradientEngine::Fused, batch, seconds)?;
             for &engine in &engines {
                 let rate = train_rate(a, engine, batch, seconds)?;
-                // The spec's one-thread PyTorch figures are for batch 64 on a CPU.
-                let reference = if batch == 64 && engine == GradientEngine::BurnCpu {
-                    let r = pytorch_reference(a);
-                    format!("{r:.0} ({:.2}×)", rate / r)
-                } else {
-                    String::new()
-                };
                 println!(
-                    "{:<11} {:>6} {:<10} {:>12.0} {:>15.0} {:>9.2}× {:>22}",
+                    "{:<11} {:>6} {:<10} {:>12.0} {:>15.0} {:>9.2}×",
                     a.name(),
                     batch,
                     engine.name(),
                     rate,
                     fused,
-                    rate / fused,
-                    reference
+                    rate / fused
                 );
             }
         }

@@ -5,6 +5,7 @@ mod contact;
 mod learn;
 mod simulate;
 mod step;
+mod torch;
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
@@ -18,8 +19,9 @@ pub struct BenchArgs {
 #[derive(Debug, Subcommand)]
 enum What {
     /// Training and inference throughput of the four networks (windows/s, one thread, batch
-    /// 64, 21 channels × 20 steps) beside the PyTorch figures of assets/docs/performance.md ("Learning engine") and this machine's
-    /// GEMM rate; then the fit time of XGBoost-style and GBDT boosting on synthetic windows.
+    /// 64, 21 channels × 20 steps) beside this machine's GEMM rate, and with --against-torch
+    /// PyTorch's CNN-BiLSTM measured in the same run; then the fit time of XGBoost-style and
+    /// GBDT boosting on synthetic windows.
     Learn {
         /// Seconds per network figure.
         #[arg(long, default_value_t = 3.0)]
@@ -38,6 +40,19 @@ enum What {
         /// Only the burn figures (skip the fused table, inference and boosting).
         #[arg(long)]
         burn_only: bool,
+        /// Also measure PyTorch's CNN-BiLSTM (assets/python/bench_torch.py, the module
+        /// `export` targets) against the engine in alternating rounds: the same windows,
+        /// batch and thread count, training and inference, both windows/s and their ratio.
+        /// Needs PyTorch for `--python` (CPU build: `pip install torch --index-url
+        /// https://download.pytorch.org/whl/cpu`).
+        #[arg(long)]
+        against_torch: bool,
+        /// Python interpreter with PyTorch, for --against-torch.
+        #[arg(long, default_value = "python3")]
+        python: String,
+        /// Alternating rounds of --against-torch (each times both, in turn first).
+        #[arg(long, default_value_t = 5)]
+        rounds: usize,
     },
     /// One wheel's contact evaluation during a simulation step (table lookup + Hertz +
     /// creepages + Polach), against FASTSIM and a full rigid solve measured in the same run.
@@ -104,6 +119,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
             burn,
             batches,
             burn_only,
+            against_torch,
+            python,
+            rounds,
         } => {
             use learn;
             use railforce::learn::neural::Architecture as A;
@@ -116,37 +134,25 @@ pub fn run(args: BenchArgs) -> Result<()> {
             let gf = learn::gemm_gflops();
             println!("GEMM [1216×128]·[128×160], one thread: {gf:.1} GFLOP/s (hardware reference)");
             println!(
-                "{:<11} {:>14} {:>10} {:>12} {:>14} {:>12}",
-                "network",
-                "train win/s",
-                "vs PyTorch",
-                "infer win/s",
-                "single window",
-                "train/GFLOP"
+                "{:<11} {:>14} {:>12} {:>14} {:>12}",
+                "network", "train win/s", "infer win/s", "single window", "train/GFLOP"
             );
-            let mut paper_net = None;
             for a in [A::CnnBiLstm, A::Cnn, A::BiLstm, A::Gru] {
                 let b = learn::run(a, 64, seconds);
-                if a == A::CnnBiLstm {
-                    paper_net = Some(b.clone());
-                }
                 println!(
-                    "{:<11} {:>14.0} {:>9.2}× {:>12.0} {:>11.3} ms {:>12.1}",
+                    "{:<11} {:>14.0} {:>12.0} {:>11.3} ms {:>12.1}",
                     a.name(),
                     b.train_windows_per_s,
-                    b.train_windows_per_s / b.pytorch_train_reference,
                     b.infer_windows_per_s,
                     b.single_ms,
                     b.train_windows_per_s / gf
                 );
             }
-            if let Some(b) = paper_net {
+            if against_torch {
+                torch::compare(&python, A::CnnBiLstm, 64, rounds, seconds)?;
+            } else {
                 println!(
-                    "cnn-bilstm inference vs PyTorch (performance.md: {:.0} windows/s batched, {:.2} ms one window): {:.2}× batched, {:.1}× one window",
-                    learn::PYTORCH_INFER_WINDOWS_PER_S,
-                    learn::PYTORCH_SINGLE_MS,
-                    b.infer_windows_per_s / learn::PYTORCH_INFER_WINDOWS_PER_S,
-                    learn::PYTORCH_SINGLE_MS / b.single_ms
+                    "(against PyTorch in the same run, alternating rounds: --against-torch; needs PyTorch)"
                 );
             }
             let lat = learn::streaming_latency_us(5000);

@@ -1,0 +1,178 @@
+//! `bench learn --against-torch`: PyTorch's CNN-BiLSTM against the engine in alternating
+//! rounds on this machine, now: the same windows (21 channels × 20 steps, `sin(0.618·i)`),
+//! the same training batch, inference in batches of 1 024, one thread each. PyTorch runs in
+//! one Python process kept between rounds (assets/python/bench_torch.py `--serve`), so its
+//! start and import are not timed.
+
+use super::learn;
+use anyhow::{Context, Result, bail};
+use railforce::learn::neural::Architecture;
+use railforce::learn::train::GradientEngine;
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+
+const SCRIPT: &str = include_str!("../../../assets/python/bench_torch.py");
+const NETS: &str = include_str!("../../../assets/python/railforce_nets.py");
+
+/// The PyTorch side: a `bench_torch.py --serve` process.
+struct Torch {
+    child: Child,
+    stdin: ChildStdin,
+    stdout: BufReader<ChildStdout>,
+    version: String,
+}
+
+impl Torch {
+    fn start(python: &str, batch: usize) -> Result<Self> {
+        let dir = std::env::temp_dir().join(format!(
+            "railforce-{}-torch-{}",
+            env!("CARGO_PKG_VERSION"),
+            std::process::id()
+        ));
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        for (name, text) in [("bench_torch.py", SCRIPT), ("railforce_nets.py", NETS)] {
+            std::fs::write(dir.join(name), text)
+                .with_context(|| format!("writing {}", dir.join(name).display()))?;
+        }
+        let mut child = Command::new(python)
+            .arg("-u")
+            .arg(dir.join("bench_torch.py"))
+            .args(["--serve", "--threads", "1", "--batch", &batch.to_string()])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .with_context(|| {
+                format!("starting {python} (give --python an interpreter with PyTorch)")
+            })?;
+        let stdin = child.stdin.take().expect("piped");
+        let mut stdout = BufReader::new(child.stdout.take().expect("piped"));
+        let mut line = String::new();
+        stdout.read_line(&mut line)?;
+        let Some(version) = line.strip_prefix("ready ") else {
+            let mut err = String::new();
+            if let Some(mut e) = child.stderr.take() {
+                std::io::Read::read_to_string(&mut e, &mut err).ok();
+            }
+            let _ = child.wait();
+            let last = err
+                .lines()
+                .rev()
+                .find(|l| !l.trim().is_empty())
+                .unwrap_or("");
+            bail!(
+                "{python} could not run the PyTorch benchmark ({}): install the CPU build with `{python} -m pip install torch --index-url https://download.pytorch.org/whl/cpu`, or name another interpreter with --python",
+                last.trim()
+            );
+        };
+        let version = version.trim().to_string();
+        std::fs::remove_dir_all(&dir).ok();
+        Ok(Torch {
+            child,
+            stdin,
+            stdout,
+            version,
+        })
+    }
+
+    /// One figure: `what` is `train` or `infer`.
+    fn rate(&mut self, what: &str, a: Architecture, seconds: f64) -> Result<f64> {
+        writeln!(self.stdin, "{what} {} {seconds}", a.name())?;
+        self.stdin.flush()?;
+        let mut line = String::new();
+        if self.stdout.read_line(&mut line)? == 0 {
+            bail!("the PyTorch process ended while timing {what}");
+        }
+        line.strip_prefix(what)
+            .and_then(|v| v.trim().parse().ok())
+            .with_context(|| format!("PyTorch answered {:?} to {what}", line.trim()))
+    }
+}
+
+impl Drop for Torch {
+    fn drop(&mut self) {
+        let _ = writeln!(self.stdin, "quit");
+        let _ = self.child.wait();
+    }
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    }
+}
+
+/// Times `a` in railforce's fused engine and in PyTorch, `rounds` alternating rounds of
+/// `seconds` per figure (odd rounds railforce first, even rounds PyTorch first), and prints
+/// each round, the medians and the ratios.
+pub fn compare(
+    python: &str,
+    a: Architecture,
+    batch: usize,
+    rounds: usize,
+    seconds: f64,
+) -> Result<()> {
+    let mut torch = Torch::start(python, batch)?;
+    println!(
+        "same-run comparison with {} (CPU, one thread each): {}, 21 channels × 20 steps, training batch {batch} (forward + backward + Adam, dropout 0.2), inference in batches of 1024; {rounds} alternating rounds of {seconds} s a figure",
+        torch.version,
+        a.name()
+    );
+    println!(
+        "{:>5} {:>10} {:>15} {:>13} {:>7} {:>15} {:>13} {:>7}",
+        "round",
+        "first",
+        "railforce train",
+        "PyTorch train",
+        "ratio",
+        "railforce infer",
+        "PyTorch infer",
+        "ratio"
+    );
+    let (mut train, mut infer) = (Vec::new(), Vec::new());
+    for r in 0..rounds.max(1) {
+        let ours_first = r % 2 == 0;
+        let mut figures = [[0.0; 2]; 2];
+        for side in 0..2 {
+            let ours = (side == 0) == ours_first;
+            let t = if ours {
+                learn::train_rate(a, GradientEngine::Fused, batch, seconds)?
+            } else {
+                torch.rate("train", a, seconds)?
+            };
+            let i = if ours {
+                learn::infer_rate(a, seconds)
+            } else {
+                torch.rate("infer", a, seconds)?
+            };
+            figures[usize::from(!ours)] = [t, i];
+        }
+        let [[rt, ri], [pt, pi]] = figures;
+        println!(
+            "{:>5} {:>10} {rt:>15.0} {pt:>13.0} {:>6.2}× {ri:>15.0} {pi:>13.0} {:>6.2}×",
+            r + 1,
+            if ours_first { "railforce" } else { "PyTorch" },
+            rt / pt,
+            ri / pi
+        );
+        train.push([rt, pt]);
+        infer.push([ri, pi]);
+    }
+    for (what, v) in [("training", &train), ("inference", &infer)] {
+        let ratios: Vec<f64> = v.iter().map(|[a, b]| a / b).collect();
+        let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = ratios.iter().copied().fold(0.0, f64::max);
+        println!(
+            "{what}: railforce {:.0} windows/s, PyTorch {:.0} (medians); railforce/PyTorch {:.2}× (median of the rounds' ratios, {lo:.2}–{hi:.2}×)",
+            median(&v.iter().map(|x| x[0]).collect::<Vec<_>>()),
+            median(&v.iter().map(|x| x[1]).collect::<Vec<_>>()),
+            median(&ratios)
+        );
+    }
+    Ok(())
+}
