@@ -333,7 +333,7 @@ fn revised_element_keys_are_checked() {
 }
 
 /// The plan key `rail_support`: the plan's for every condition, a condition's own over it; a
-/// data set of the curve on sleepers generates (at 0.25 ms, the step on sleepers) with the
+/// data set of the curve on sleepers generates (at 0.2 ms, the step on sleepers) with the
 /// wagon's weight on its wheels; a lumped track asked of a file without one, or an unknown
 /// model, is refused naming the key.
 #[test]

@@ -530,6 +530,7 @@ pub fn run(
         "commit": source_commit(),
         "started_unix": unix_now(),
     });
+    let mut took: Vec<(&str, f64)> = Vec::new();
     for part in parts.clone() {
         let ts = Instant::now();
         let mut sec = match part {
@@ -565,8 +566,18 @@ pub fn run(
             w.write_all(pj.as_bytes())
         })?;
         timings.insert(format!("{folder}_s"), json!(secs));
+        took.push((folder, secs));
     }
     let wall = t0.elapsed().as_secs_f64();
+    log("wall time of each part:".into());
+    for (folder, secs) in &took {
+        log(format!("  {folder:<15} {}", snapshot::minutes(*secs)));
+    }
+    log(format!(
+        "  {:<15} {} (simulating the plan's data and the rest)",
+        "in all",
+        snapshot::minutes(wall)
+    ));
     let mut meta = common.clone();
     meta["wall_seconds"] = json!(wall);
     meta["finished_unix"] = json!(unix_now());

@@ -222,7 +222,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         title: "7. The simulator's form: lumped track against rails on sleepers (not in the paper)".into(),
         text: vec![
             format!(
-                "Every run of the plan simulated again on rails on discrete sleepers ({}: rails as beams on pads, sleepers, ballast and subgrade, the same conditions, seeds and irregularities, 0.25 ms), and one CNN-BiLSTM on the paper's 21 trained on each track's data under the same split and noise: each tested on its own track and on the other. A network that keeps its R² across the change of track model carries what it learned from the vehicle, not from one track model's numbers.",
+                "Every run of the plan simulated again on rails on discrete sleepers ({}: rails as beams on pads, sleepers, ballast and subgrade, the same conditions, seeds and irregularities, 0.2 ms), and one CNN-BiLSTM on the paper's 21 trained on each track's data under the same split and noise: each tested on its own track and on the other. A network that keeps its R² across the change of track model carries what it learned from the vehicle, not from one track model's numbers.",
                 beams.name
             ),
             format!(

@@ -488,7 +488,7 @@ fn range(t: &Table, rows: &[&Vec<String>], column: &str) -> String {
 }
 
 /// "12.3 min" (or seconds below a minute).
-fn minutes(s: f64) -> String {
+pub(super) fn minutes(s: f64) -> String {
     if s < 60.0 {
         format!("{s:.0} s")
     } else {
