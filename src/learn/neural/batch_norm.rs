@@ -44,11 +44,14 @@ impl BatchNorm {
         let (mean, var) = if train && rows > 1 {
             let mut mean = vec![0.0f64; c];
             let mut sq = vec![0.0f64; c];
+            // Each channel summed over the rows in order (the same sums as a row-by-row loop);
+            // across channels the loop vectorises.
             for row in x.chunks_exact(c) {
-                for ((m, s), &v) in mean.iter_mut().zip(sq.iter_mut()).zip(row) {
-                    let v = v as f64;
-                    *m += v;
-                    *s += v * v;
+                let (m, s) = (&mut mean[..c], &mut sq[..c]);
+                for k in 0..c {
+                    let v = row[k] as f64;
+                    m[k] += v;
+                    s[k] += v * v;
                 }
             }
             let n = rows as f64;
@@ -77,9 +80,12 @@ impl BatchNorm {
         let beta = &p.value[self.beta.clone()];
         if train {
             self.xhat.resize(x.len(), 0.0);
+            let (mean, inv, gamma, beta) =
+                (&mean[..c], &self.inv_std[..c], &gamma[..c], &beta[..c]);
             for (row, xh) in x.chunks_exact_mut(c).zip(self.xhat.chunks_exact_mut(c)) {
+                let (row, xh) = (&mut row[..c], &mut xh[..c]);
                 for k in 0..c {
-                    xh[k] = (row[k] - mean[k]) * self.inv_std[k];
+                    xh[k] = (row[k] - mean[k]) * inv[k];
                     row[k] = gamma[k] * xh[k] + beta[k];
                 }
             }
@@ -117,9 +123,11 @@ impl BatchNorm {
         let mut sum_dy = vec![0.0f32; c];
         let mut sum_dy_xhat = vec![0.0f32; c];
         for (row, xh) in dy.chunks_exact(c).zip(self.xhat.chunks_exact(c)) {
+            let (row, xh) = (&row[..c], &xh[..c]);
+            let (sd, sx) = (&mut sum_dy[..c], &mut sum_dy_xhat[..c]);
             for k in 0..c {
-                sum_dy[k] += row[k];
-                sum_dy_xhat[k] += row[k] * xh[k];
+                sd[k] += row[k];
+                sx[k] += row[k] * xh[k];
             }
         }
         for k in 0..c {
@@ -130,9 +138,11 @@ impl BatchNorm {
         let scale: Vec<f32> = (0..c)
             .map(|k| p.value[self.gamma.start + k] * self.inv_std[k])
             .collect();
+        let (scale, sd, sx) = (&scale[..c], &sum_dy[..c], &sum_dy_xhat[..c]);
         for (row, xh) in dy.chunks_exact_mut(c).zip(self.xhat.chunks_exact(c)) {
+            let (row, xh) = (&mut row[..c], &xh[..c]);
             for k in 0..c {
-                row[k] = scale[k] * (row[k] - sum_dy[k] / n - xh[k] * sum_dy_xhat[k] / n);
+                row[k] = scale[k] * (row[k] - sd[k] / n - xh[k] * sx[k] / n);
             }
         }
     }

@@ -36,6 +36,9 @@ pub struct BiLstm {
     hs: Vec<f32>,
     /// `tanh(c)` after each step, `[2][T][B][H]`.
     tc: Vec<f32>,
+    /// The backward pass's gate gradients `[B·T][2·4H]`, kept between steps (every entry is
+    /// written before it is read).
+    dg: Vec<f32>,
 }
 
 impl BiLstm {
@@ -56,6 +59,7 @@ impl BiLstm {
             cs: Vec::new(),
             hs: Vec::new(),
             tc: Vec::new(),
+            dg: Vec::new(),
         }
     }
 
@@ -195,7 +199,8 @@ impl BiLstm {
         let (h, g4, d) = (self.h, 4 * self.h, self.din);
         let (batch, steps) = (self.batch, self.steps);
         let rows = batch * steps;
-        let mut dg = vec![0.0f32; rows * 2 * g4];
+        let mut dg = std::mem::take(&mut self.dg);
+        dg.resize(rows * 2 * g4, 0.0);
         let mut dh = vec![0.0f32; batch * h];
         let mut dc = vec![0.0f32; batch * h];
         let ld = steps * 2 * g4;
@@ -241,6 +246,7 @@ impl BiLstm {
         let w = &p.value[self.w_ih.clone()];
         let dw = &mut p.grad[self.w_ih.clone()];
         affine_backward(x, &dg, rows, d, 2 * g4, w, dw, dx);
+        self.dg = dg;
     }
 }
 
