@@ -10,8 +10,8 @@
 //! two rails' amplitudes of k and of 2N − k, the sleepers' bounce and roll, the two ballast
 //! blocks') and five lateral (the rails' two amplitudes each, the sleepers' sway), and the
 //! pinned–pinned modes (k = N, nodes at every fastener: no pad reaches them), one per rail and
-//! direction. A rail's modal coordinate `q_k` of `φ_k = √(2/mL)·sin(kπx/L)` is its amplitude
-//! divided by `√(2/mL)`, so the amplitude behaves as a mass `m_k·s` per fastener with the
+//! direction. A rail's modal coordinate `q_k` of `φ_k = √(2/(m_k·L))·sin(kπx/L)` (`m_k` the mode's
+//! mass per length) is its amplitude divided by `√(2/(m_k·L))`, so the amplitude behaves as a mass `m_k·s` per fastener with the
 //! bending stiffness `s·m_k·ω_k²` of its free wave ([`super::DiscreteSupport::bending`]:
 //! Timoshenko's flexural branch, or Euler–Bernoulli's `EI·κ⁴`); a pad stretches by the
 //! difference of the two amplitudes; the ballast's shear adds `2·k_w·(1 − cos(kπ/N))` to each
@@ -22,7 +22,7 @@
 //! dampers shared into the step's end, its inverse built once per step length:
 //! `(M + Δt/2·C + Δt²/12·K + Δt²·B)·Δv = Δt·(F − K·x − B·(x + Δt·v) − C·v)`, `Δx = Δt·(v + Δv)`.
 //! `B`, the rails' bending and their own pads, is backward Euler: the bending modes up to
-//! 1.4 kHz, which no step of the run follows, are damped rather than left ringing (with no
+//! 2.8 kHz (half a bay, vertical), which no step of the run follows, are damped rather than left ringing (with no
 //! numerical damping on them, α = ¼, Q's standard deviation was 34 % off at 0.5 ms on
 //! R 400 m at 100 km/h). `K`, the rest of the pads, the sleepers and the ballast, takes Fox and
 //! Goodwin's share (α = 1/12: a linear spring's frequency right to fourth order, stable below

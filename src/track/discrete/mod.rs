@@ -2,7 +2,7 @@
 //! vehicle–track model of Zhai's school, in a window of track that moves with the vehicle.
 //!
 //! Per rail, a vertical and a lateral Timoshenko beam (or Euler–Bernoulli, `rail_beam`), simply
-//! supported at the window's ends, in modal coordinates (`φ_k(x) = √(2/(m·L))·sin(kπx/L)`, two
+//! supported at the window's ends, in modal coordinates (`φ_k(x) = √(2/(m_k·L))·sin(kπx/L)`, two
 //! modes per fastener and the pinned–pinned mode, so the rail bends between the sleepers).
 //! Each fastener is a rail pad (vertical and lateral spring and damper) to a rigid sleeper
 //! (vertical, lateral and roll); under each rail seat a ballast block on the subgrade, coupled
@@ -12,8 +12,9 @@
 //! by whole bays exactly.
 //!
 //! What the model leaves out (stated, not hidden):
-//! - **the Timoshenko beam's second branch** (the shear wave, cut on near 6.7 kHz for CHN60)
-//!   and wavelengths under one bay: the rail's response ends near 2 kHz;
+//! - **the Timoshenko beam's second branch** (the shear wave, cut on near 5.0 kHz for CHN60
+//!   vertically) and wavelengths under one bay: the shortest modes, half a bay long, stand at
+//!   2.8 kHz vertically and 1.9 kHz laterally;
 //! - **rail roll** (torsion): the lateral beam is the rail head on the lateral pads, so the
 //!   lateral compliance lacks the roll part the lumped model lumps in;
 //! - **the pads' length**: a fastener is a point, so nothing damps the pinned–pinned mode but

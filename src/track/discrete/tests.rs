@@ -128,24 +128,28 @@ fn moving_load_below_critical_speed_carries_its_basin() {
     assert!(((t.start() - start) / p.spacing).round() >= 33.0);
 }
 
-/// A free track released from a displaced state loses energy: the rails come back to rest
+/// A free track released from a displaced state (loaded at mid-span, so the pinned–pinned
+/// mode moves too) loses energy: the rails come back to rest
 /// (no step-made energy at the default 5/6 ms step, whose explicit parts are the sleepers'
 /// and the ballast's neighbours).
 #[test]
 fn released_track_comes_to_rest_at_the_default_step() {
     let p = DiscreteSupport::default();
-    let mut t = settled(p, 12.0, &pair(12.0, 150e3));
-    let lateral = Load::wheelset(12.0, 40e3, 0.0);
+    let mut t = settled(p, 12.0, &pair(12.3, 150e3));
+    let lateral = Load::wheelset(12.3, 40e3, 0.0);
     t.settle(5e-4, 0.5, &lateral);
     let dt = 1.0 / 1200.0;
     let mut peak = [0.0f64; 2];
     for i in 0..2400 {
         t.step(dt, &[]);
-        let r = t.rail(0, 12.0);
-        assert!(r.iter().all(|x| x.is_finite()));
-        if i > 1200 {
-            peak[0] = peak[0].max(r[0].abs());
-            peak[1] = peak[1].max(r[2].abs());
+        // Over the sleeper and at mid-span, where the pinned–pinned mode moves.
+        for s in [12.0, 12.3] {
+            let r = t.rail(0, s);
+            assert!(r.iter().all(|x| x.is_finite()));
+            if i > 1200 {
+                peak[0] = peak[0].max(r[0].abs());
+                peak[1] = peak[1].max(r[2].abs());
+            }
         }
     }
     assert!(peak[0] < 1e-6 && peak[1] < 1e-6, "{peak:?}");
@@ -227,7 +231,8 @@ fn peaks(r: &[(f64, f64)]) -> Vec<f64> {
 /// the receptance is less than two thirds of it. The closed
 /// form at 0.65 m against the first stop bands a periodic-structure study of a rail on
 /// sleepers 0.65 m apart reports (J. Adv. Transp. 2021, 6635198, Table 2: 445.2–459.7 Hz and
-/// 962.5–1001.5 Hz): lateral and vertical within 5 % of the band.
+/// 962.5–1001.5 Hz): lateral and vertical within 5 % of the band (measured 3.3 % above the
+/// lateral band, 1.8 % below the vertical one).
 #[test]
 fn pinned_pinned_resonance_at_mid_span() {
     let p = DiscreteSupport::default();
