@@ -169,15 +169,16 @@ enum Command {
     )]
     Identify(identify::IdentifyArgs),
     /// Rerun the paper's experiments: model comparison, generalisation over conditions
-    /// (with leave-one-condition-out) and robustness to noise, and three of ours: the protocols
-    /// side by side, on-board sensor selection, and wagons the models did not learn
-    /// (mismatch: nominal against fleet-trained). Defaults: split by seed (independent test
-    /// runs), 6 dB with σ from each channel's std, centre label. Writes tables (Markdown,
-    /// CSV), SVG figures and index.html with the paper's numbers beside ours. A run of all
-    /// six writes results.md, the snapshot of what it measured (date, commit, protocol, the
-    /// wall time of each part, every table); `experiment snapshot` rewrites it from a
-    /// finished folder. The full protocol on the paper's 34 conditions takes one to two
-    /// hours on two cores, most of it training.
+    /// (with leave-one-condition-out) and robustness to noise, and four of ours: the protocols
+    /// side by side, on-board sensor selection, wagons the models did not learn (mismatch:
+    /// nominal against fleet-trained) and the simulator's own form (model-form: lumped track
+    /// against rails on sleepers). Defaults: split by seed (independent test runs), 6 dB with
+    /// σ from each channel's std, centre label. Writes tables (Markdown, CSV), SVG figures and
+    /// index.html with the paper's numbers beside ours, and prints each part's wall time at
+    /// the end. A run of all seven writes results.md, the snapshot of what it measured (date,
+    /// commit, protocol, the wall time of each part, every table); `experiment snapshot`
+    /// rewrites it from a finished folder. The full protocol on the paper's 34 conditions
+    /// takes about three and a half hours on two cores (results.md), most of it training.
     #[command(
         after_help = "Examples:\n  railforce experiment comparison --plan demo --out experiments --epochs 2 --windows-per-epoch 2000"
     )]
