@@ -188,6 +188,41 @@ fn bench_simulate_against_another_binary() {
     assert!(!ok && err.contains("--against no-such-railforce"), "{err}");
 }
 
+/// `bench learn --against-torch` checks PyTorch before it times anything: an interpreter that
+/// does not start, or one that cannot run the benchmark, is named with the install line.
+#[test]
+fn bench_learn_against_torch_names_a_missing_pytorch() {
+    let base = [
+        "bench",
+        "learn",
+        "--rows",
+        "0",
+        "--seconds",
+        "0.01",
+        "--against-torch",
+    ];
+    let run = |python: &str| {
+        railforce(
+            &base
+                .into_iter()
+                .chain(["--python", python])
+                .collect::<Vec<_>>(),
+        )
+    };
+    let (ok, out, err) = run("no-such-python");
+    assert!(!ok && err.contains("starting no-such-python"), "{err}");
+    assert!(
+        !out.contains("train win/s"),
+        "timed before the check: {out}"
+    );
+    let (ok, _, err) = run("false");
+    assert!(
+        !ok && err.contains("false could not run the PyTorch benchmark")
+            && err.contains("--index-url https://download.pytorch.org/whl/cpu"),
+        "{err}"
+    );
+}
+
 #[test]
 fn validate_contact_passes_on_the_built_in_reference_data_from_any_folder() {
     // Run from an empty folder: the reference data are built into the binary.

@@ -131,6 +131,12 @@ pub fn run(args: BenchArgs) -> Result<()> {
             if burn_only {
                 return learn::burn_table(&burn, &batches, seconds);
             }
+            // PyTorch first: a missing one stops the bench before it has timed anything.
+            let torch = if against_torch {
+                Some(torch::Torch::start(&python, 64)?)
+            } else {
+                None
+            };
             let gf = learn::gemm_gflops();
             println!("GEMM [1216×128]·[128×160], one thread: {gf:.1} GFLOP/s (hardware reference)");
             println!(
@@ -148,8 +154,8 @@ pub fn run(args: BenchArgs) -> Result<()> {
                     b.train_windows_per_s / gf
                 );
             }
-            if against_torch {
-                torch::compare(&python, A::CnnBiLstm, 64, rounds, seconds)?;
+            if let Some(torch) = torch {
+                torch::compare(torch, A::CnnBiLstm, 64, rounds, seconds)?;
             } else {
                 println!(
                     "(against PyTorch in the same run, alternating rounds: --against-torch; needs PyTorch)"

@@ -15,7 +15,7 @@ const SCRIPT: &str = include_str!("../../../assets/python/bench_torch.py");
 const NETS: &str = include_str!("../../../assets/python/railforce_nets.py");
 
 /// The PyTorch side: a `bench_torch.py --serve` process.
-struct Torch {
+pub struct Torch {
     child: Child,
     stdin: ChildStdin,
     stdout: BufReader<ChildStdout>,
@@ -23,7 +23,9 @@ struct Torch {
 }
 
 impl Torch {
-    fn start(python: &str, batch: usize) -> Result<Self> {
+    /// Starts PyTorch's side under `python` for training batches of `batch`: an error naming
+    /// the interpreter and the install line where it has no PyTorch.
+    pub fn start(python: &str, batch: usize) -> Result<Self> {
         let dir = std::env::temp_dir().join(format!(
             "railforce-{}-torch-{}",
             env!("CARGO_PKG_VERSION"),
@@ -107,17 +109,16 @@ fn median(v: &[f64]) -> f64 {
     }
 }
 
-/// Times `a` in railforce's fused engine and in PyTorch, `rounds` alternating rounds of
-/// `seconds` per figure (odd rounds railforce first, even rounds PyTorch first), and prints
-/// each round, the medians and the ratios.
+/// Times `a` in railforce's fused engine and in PyTorch (started for `batch`), `rounds`
+/// alternating rounds of `seconds` per figure (odd rounds railforce first, even rounds
+/// PyTorch first), and prints each round, the medians and the ratios.
 pub fn compare(
-    python: &str,
+    mut torch: Torch,
     a: Architecture,
     batch: usize,
     rounds: usize,
     seconds: f64,
 ) -> Result<()> {
-    let mut torch = Torch::start(python, batch)?;
     println!(
         "same-run comparison with {} (CPU, one thread each): {}, 21 channels × 20 steps, training batch {batch} (forward + backward + Adam, dropout 0.2), inference in batches of 1024; {rounds} alternating rounds of {seconds} s a figure",
         torch.version,
