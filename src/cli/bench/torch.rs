@@ -49,22 +49,28 @@ impl Torch {
             })?;
         let stdin = child.stdin.take().expect("piped");
         let mut stdout = BufReader::new(child.stdout.take().expect("piped"));
+        // PyTorch's warnings drained as they come, so a full pipe never stalls it.
+        let stderr = child.stderr.take();
+        let drain = std::thread::spawn(move || {
+            let mut err = String::new();
+            if let Some(mut e) = stderr {
+                std::io::Read::read_to_string(&mut e, &mut err).ok();
+            }
+            err
+        });
         let mut line = String::new();
         stdout.read_line(&mut line)?;
         let Some(version) = line.strip_prefix("ready ") else {
-            let mut err = String::new();
-            if let Some(mut e) = child.stderr.take() {
-                std::io::Read::read_to_string(&mut e, &mut err).ok();
-            }
             let _ = child.wait();
+            let err = drain.join().unwrap_or_default();
             let last = err
                 .lines()
                 .rev()
                 .find(|l| !l.trim().is_empty())
-                .unwrap_or("");
+                .map(|l| format!(" ({})", l.trim()))
+                .unwrap_or_default();
             bail!(
-                "{python} could not run the PyTorch benchmark ({}): install the CPU build with `{python} -m pip install torch --index-url https://download.pytorch.org/whl/cpu`, or name another interpreter with --python",
-                last.trim()
+                "{python} could not run the PyTorch benchmark{last}: install the CPU build with `{python} -m pip install torch --index-url https://download.pytorch.org/whl/cpu`, or name another interpreter with --python"
             );
         };
         let version = version.trim().to_string();
