@@ -47,7 +47,7 @@ class Trainer:
         b = torch.arange(batch, dtype=torch.float32, device=device)
         self.y = torch.cos(0.1 * b).reshape(batch, 1)
         self.big = windows(INFER_BATCH, device)
-        for _ in range(5):  # warm-up (allocator, cuDNN plans), as the engine's three
+        for _ in range(5):  # warm-up, untimed (allocator, cuDNN plans); the engine takes three
             self.step()
         with torch.no_grad():
             self.net.eval()
@@ -86,7 +86,7 @@ class Trainer:
 
 def serve(batch, device):
     trainers = {}
-    print(f"ready PyTorch {torch.__version__} threads {torch.get_num_threads()}", flush=True)
+    print(f"ready PyTorch {torch.__version__} on {device}, threads {torch.get_num_threads()}", flush=True)
     for line in sys.stdin:
         parts = line.split()
         if not parts:

@@ -88,7 +88,7 @@ def simulate(
     ``"daqin_20kt"``, their ``_empty`` forms, or a consist file) and ``position`` (the
     wagon's place as a fraction of the train from the head) as ``--consist`` and
     ``--position`` take them; a run in a train adds the ``coupler_*`` channels.
-    ``rail_support`` (``"rigid"``, ``"lumped"``, ``"discrete"``: rails on sleepers, 0.25 ms
+    ``rail_support`` (``"rigid"``, ``"lumped"``, ``"discrete"``: rails on sleepers, 0.2 ms
     unless ``dt``) as ``--rail-support`` chooses it over the track file's; ``roughness``
     (``"iso3095"``, ``"cnossos_m"``, ``"none"``) as ``--roughness`` puts rail roughness on the
     rails (the step then follows it: 62.5 µs).

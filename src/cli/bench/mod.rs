@@ -51,8 +51,8 @@ enum What {
         #[arg(long, default_value = "python3")]
         python: String,
         /// Alternating rounds of --against-torch (each times both, in turn first).
-        #[arg(long, default_value_t = 5)]
-        rounds: usize,
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+        rounds: u32,
     },
     /// One wheel's contact evaluation during a simulation step (table lookup + Hertz +
     /// creepages + Polach), against FASTSIM and a full rigid solve measured in the same run.
@@ -128,6 +128,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
             if cfg!(debug_assertions) {
                 eprintln!("warning: debug build; use `cargo run --release -- bench learn`");
             }
+            if burn_only && against_torch {
+                anyhow::bail!(
+                    "--against-torch times the fused engine, which --burn-only skips: give one of them"
+                );
+            }
             if burn_only {
                 return learn::burn_table(&burn, &batches, seconds);
             }
@@ -155,7 +160,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 );
             }
             if let Some(torch) = torch {
-                torch::compare(torch, A::CnnBiLstm, 64, rounds, seconds)?;
+                torch::compare(torch, A::CnnBiLstm, 64, rounds as usize, seconds)?;
             } else {
                 println!(
                     "(against PyTorch in the same run, alternating rounds: --against-torch; needs PyTorch)"

@@ -10,6 +10,8 @@ use railforce::learn::neural::Architecture;
 use railforce::learn::train::GradientEngine;
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::thread::JoinHandle;
 
 const SCRIPT: &str = include_str!("../../../assets/python/bench_torch.py");
 const NETS: &str = include_str!("../../../assets/python/railforce_nets.py");
@@ -19,19 +21,38 @@ pub struct Torch {
     child: Child,
     stdin: ChildStdin,
     stdout: BufReader<ChildStdout>,
+    /// Its standard error, read as it comes (so a full pipe never stalls it).
+    stderr: Option<JoinHandle<String>>,
     version: String,
 }
 
+/// The last non-empty line of what a process wrote to standard error, as ` (line)`.
+fn last_line(err: &str) -> String {
+    err.lines()
+        .rev()
+        .find(|l| !l.trim().is_empty())
+        .map(|l| format!(" ({})", l.trim()))
+        .unwrap_or_default()
+}
+
 impl Torch {
-    /// Starts PyTorch's side under `python` for training batches of `batch`: an error naming
-    /// the interpreter and the install line where it has no PyTorch.
+    /// Starts PyTorch's side under `python` on the CPU for training batches of `batch`: an
+    /// error naming the interpreter and the install line where it has no PyTorch.
     pub fn start(python: &str, batch: usize) -> Result<Self> {
+        static STARTS: AtomicUsize = AtomicUsize::new(0);
         let dir = std::env::temp_dir().join(format!(
-            "railforce-{}-torch-{}",
+            "railforce-{}-torch-{}-{}",
             env!("CARGO_PKG_VERSION"),
-            std::process::id()
+            std::process::id(),
+            STARTS.fetch_add(1, Ordering::Relaxed)
         ));
-        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        std::fs::create_dir(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        let started = Self::spawn(python, batch, &dir);
+        std::fs::remove_dir_all(&dir).ok();
+        started
+    }
+
+    fn spawn(python: &str, batch: usize, dir: &std::path::Path) -> Result<Self> {
         for (name, text) in [("bench_torch.py", SCRIPT), ("railforce_nets.py", NETS)] {
             std::fs::write(dir.join(name), text)
                 .with_context(|| format!("writing {}", dir.join(name).display()))?;
@@ -39,7 +60,8 @@ impl Torch {
         let mut child = Command::new(python)
             .arg("-u")
             .arg(dir.join("bench_torch.py"))
-            .args(["--serve", "--threads", "1", "--batch", &batch.to_string()])
+            .args(["--serve", "--device", "cpu", "--threads", "1"])
+            .args(["--batch", &batch.to_string()])
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
@@ -49,7 +71,6 @@ impl Torch {
             })?;
         let stdin = child.stdin.take().expect("piped");
         let mut stdout = BufReader::new(child.stdout.take().expect("piped"));
-        // PyTorch's warnings drained as they come, so a full pipe never stalls it.
         let stderr = child.stderr.take();
         let drain = std::thread::spawn(move || {
             let mut err = String::new();
@@ -59,26 +80,23 @@ impl Torch {
             err
         });
         let mut line = String::new();
-        stdout.read_line(&mut line)?;
-        let Some(version) = line.strip_prefix("ready ") else {
+        let read = stdout.read_line(&mut line);
+        let Some(version) = line.strip_prefix("ready ").filter(|_| read.is_ok()) else {
+            // Whatever it printed instead, it is not the benchmark: stop it.
+            drop(stdin);
+            let _ = child.kill();
             let _ = child.wait();
-            let err = drain.join().unwrap_or_default();
-            let last = err
-                .lines()
-                .rev()
-                .find(|l| !l.trim().is_empty())
-                .map(|l| format!(" ({})", l.trim()))
-                .unwrap_or_default();
+            let last = last_line(&drain.join().unwrap_or_default());
             bail!(
                 "{python} could not run the PyTorch benchmark{last}: install the CPU build with `{python} -m pip install torch --index-url https://download.pytorch.org/whl/cpu`, or name another interpreter with --python"
             );
         };
         let version = version.trim().to_string();
-        std::fs::remove_dir_all(&dir).ok();
         Ok(Torch {
             child,
             stdin,
             stdout,
+            stderr: Some(drain),
             version,
         })
     }
@@ -89,7 +107,16 @@ impl Torch {
         self.stdin.flush()?;
         let mut line = String::new();
         if self.stdout.read_line(&mut line)? == 0 {
-            bail!("the PyTorch process ended while timing {what}");
+            let _ = self.child.wait();
+            let err = self
+                .stderr
+                .take()
+                .and_then(|h| h.join().ok())
+                .unwrap_or_default();
+            bail!(
+                "the PyTorch process ended while timing {what}{}",
+                last_line(&err)
+            );
         }
         line.strip_prefix(what)
             .and_then(|v| v.trim().parse().ok())
@@ -126,7 +153,7 @@ pub fn compare(
     seconds: f64,
 ) -> Result<()> {
     println!(
-        "same-run comparison with {} (CPU, one thread each): {}, 21 channels × 20 steps, training batch {batch} (forward + backward + Adam, dropout 0.2), inference in batches of 1024; {rounds} alternating rounds of {seconds} s a figure",
+        "same-run comparison with {} (railforce one thread): {}, 21 channels × 20 steps, training batch {batch} (forward + backward + Adam, dropout 0.2), inference in batches of 1024; {rounds} alternating rounds of {seconds} s a figure",
         torch.version,
         a.name()
     );
@@ -142,7 +169,7 @@ pub fn compare(
         "ratio"
     );
     let (mut train, mut infer) = (Vec::new(), Vec::new());
-    for r in 0..rounds.max(1) {
+    for r in 0..rounds {
         let ours_first = r % 2 == 0;
         let mut figures = [[0.0; 2]; 2];
         for side in 0..2 {
