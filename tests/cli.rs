@@ -531,38 +531,31 @@ fn demo_runs_from_an_empty_folder() {
 fn a_burst_is_named_and_a_step_too_coarse_for_short_waves_refused() {
     let out = std::env::temp_dir().join(format!("railforce-burst-{}.csv", std::process::id()));
     let out = out.to_str().unwrap();
-    let (ok, _, err) = railforce(&[
-        "simulate",
-        "--track",
-        "tangent",
-        "--speed-kmh",
-        "80",
-        "--duration",
-        "1",
-        "--dt",
-        "1e-3",
-        "--out",
-        out,
-    ]);
+    let run = |extra: &[&str]| {
+        let base = [
+            "simulate",
+            "--track",
+            "tangent",
+            "--speed-kmh",
+            "80",
+            "--duration",
+            "1",
+        ];
+        railforce(
+            &base
+                .iter()
+                .chain(extra)
+                .chain(&["--out", out])
+                .copied()
+                .collect::<Vec<_>>(),
+        )
+    };
+    let (ok, _, err) = run(&["--dt", "1e-3"]);
     assert!(
         !ok && err.contains("a jump") && err.contains("finer --dt"),
         "{err}"
     );
-    let (ok, _, err) = railforce(&[
-        "simulate",
-        "--track",
-        "tangent",
-        "--speed-kmh",
-        "80",
-        "--duration",
-        "1",
-        "--dt",
-        "5e-4",
-        "--roughness",
-        "cnossos_m",
-        "--out",
-        out,
-    ]);
+    let (ok, _, err) = run(&["--dt", "5e-4", "--roughness", "cnossos_m"]);
     assert!(
         !ok && err.contains("too coarse") && err.contains("0.0625 ms"),
         "{err}"

@@ -4,6 +4,7 @@
 //! one Python process kept between rounds (assets/python/bench_torch.py `--serve`), so its
 //! start and import are not timed.
 
+use super::against::median;
 use super::learn;
 use anyhow::{Context, Result, bail};
 use railforce::learn::neural::Architecture;
@@ -128,17 +129,6 @@ impl Drop for Torch {
     fn drop(&mut self) {
         let _ = writeln!(self.stdin, "quit");
         let _ = self.child.wait();
-    }
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let n = s.len();
-    if n % 2 == 1 {
-        s[n / 2]
-    } else {
-        0.5 * (s[n / 2 - 1] + s[n / 2])
     }
 }
 

@@ -1,6 +1,8 @@
 //! The discrete track against its closed forms, as `railforce validate track` prints them.
 
-use super::{DiscreteSupport, KelvinVoigt, Load, TrackDynamics, cut_on_frequencies, receptance};
+use super::{
+    DiscreteSupport, KelvinVoigt, Load, TrackDynamics, cut_on_frequencies, peaks, receptance,
+};
 
 /// One check: a measured value against its expected one.
 #[derive(Debug, Clone, PartialEq)]
@@ -100,15 +102,11 @@ pub fn checks(p: &DiscreteSupport) -> Vec<Check> {
     });
     let cut = cut_on_frequencies(p);
     let r = receptance(*p, 0.0, 2e-5, 0.5, 600.0);
-    let peaks: Vec<f64> = r
-        .windows(3)
-        .filter(|w| w[0].0 >= 10.0 && w[1].1 > w[0].1 && w[1].1 >= w[2].1)
-        .map(|w| w[1].0)
-        .collect();
+    let found = peaks(&r, 10.0);
     for (i, name) in ["first", "second"].iter().enumerate() {
         out.push(Check {
             name: format!("receptance over a sleeper: {name} peak against the {name} cut-on"),
-            measured: peaks.get(i).copied().unwrap_or(f64::NAN),
+            measured: found.get(i).copied().unwrap_or(f64::NAN),
             expected: cut[i],
             tolerance: 0.1,
             unit: "Hz",
@@ -116,10 +114,8 @@ pub fn checks(p: &DiscreteSupport) -> Vec<Check> {
     }
     let pp = p.pinned_pinned(false);
     let mid = receptance(*p, 0.5 * p.spacing, 2e-5, 0.5, 2.0 * pp);
-    let near = mid
-        .windows(3)
-        .filter(|w| w[0].0 >= 0.5 * pp && w[1].1 > w[0].1 && w[1].1 >= w[2].1)
-        .map(|w| w[1].0)
+    let near = peaks(&mid, 0.5 * pp)
+        .into_iter()
         .min_by(|a, b| (a - pp).abs().total_cmp(&(b - pp).abs()));
     out.push(Check {
         name: "receptance at mid-span: the pinned–pinned peak against the free rail's wave of two bays"

@@ -129,6 +129,17 @@ struct State<const D: usize> {
     dv: SVector<f64, D>,
 }
 
+impl<const D: usize> State<D> {
+    /// The velocities (`v`) or the displacements.
+    fn field(&self, v: bool) -> &SVector<f64, D> {
+        if v { &self.v } else { &self.x }
+    }
+
+    fn field_mut(&mut self, v: bool) -> &mut SVector<f64, D> {
+        if v { &mut self.v } else { &mut self.x }
+    }
+}
+
 impl<const D: usize> Default for State<D> {
     fn default() -> Self {
         State {
@@ -240,43 +251,25 @@ impl<const D: usize> Direction<D> {
         at_half_bays: &impl Fn(Vec<f64>) -> Vec<f64>,
     ) {
         let n = self.states.len();
-        for d in (0..self.fold).filter(|d| !RAIL.contains(d)) {
-            for v in [false, true] {
-                let f = |st: &State<D>| if v { st.v[d] } else { st.x[d] };
-                let moved = at_fasteners(self.states.iter().map(f).collect());
+        for v in [false, true] {
+            for d in (0..self.fold).filter(|d| !RAIL.contains(d)) {
+                let moved = at_fasteners(self.states.iter().map(|st| st.field(v)[d]).collect());
                 for (st, m) in self.states.iter_mut().zip(moved) {
-                    *(if v { &mut st.v[d] } else { &mut st.x[d] }) = m;
+                    st.field_mut(v)[d] = m;
                 }
             }
-        }
-        for r in RAIL {
-            let f = self.fold + r;
-            for v in [false, true] {
-                let pick = |st: &State<D>, d: usize| if v { st.v[d] } else { st.x[d] };
-                let pp = if v {
-                    self.pinned_state.v[r]
-                } else {
-                    self.pinned_state.x[r]
-                };
-                let amps: Vec<f64> = (self.states.iter().map(|st| pick(st, r)))
-                    .chain(std::iter::once(pp))
-                    .chain(self.states.iter().rev().map(|st| pick(st, f)))
+            for r in RAIL {
+                let f = self.fold + r;
+                let amps: Vec<f64> = (self.states.iter().map(|st| st.field(v)[r]))
+                    .chain(std::iter::once(self.pinned_state.field(v)[r]))
+                    .chain(self.states.iter().rev().map(|st| st.field(v)[f]))
                     .collect();
-                let moved = at_half_bays(amps);
-                for (k, m) in moved.into_iter().enumerate() {
-                    let (st, d) = match k.cmp(&n) {
-                        std::cmp::Ordering::Less => (&mut self.states[k], r),
-                        std::cmp::Ordering::Equal => {
-                            *(if v {
-                                &mut self.pinned_state.v[r]
-                            } else {
-                                &mut self.pinned_state.x[r]
-                            }) = m;
-                            continue;
-                        }
-                        std::cmp::Ordering::Greater => (&mut self.states[2 * n - k], f),
-                    };
-                    *(if v { &mut st.v[d] } else { &mut st.x[d] }) = m;
+                for (k, m) in at_half_bays(amps).into_iter().enumerate() {
+                    match k.cmp(&n) {
+                        std::cmp::Ordering::Less => self.states[k].field_mut(v)[r] = m,
+                        std::cmp::Ordering::Equal => self.pinned_state.field_mut(v)[r] = m,
+                        std::cmp::Ordering::Greater => self.states[2 * n - k].field_mut(v)[f] = m,
+                    }
                 }
             }
         }

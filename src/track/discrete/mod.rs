@@ -40,7 +40,7 @@ mod receptance;
 pub use checks::{Check, checks};
 pub use dynamics::{Load, TrackDynamics};
 pub(super) use file::DiscreteFile;
-pub use receptance::{cut_on_frequencies, receptance};
+pub use receptance::{cut_on_frequencies, peaks, receptance};
 
 /// A spring and a damper in parallel.
 #[derive(Debug, Clone, Copy, PartialEq)]

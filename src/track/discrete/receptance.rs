@@ -33,6 +33,14 @@ pub fn cut_on_frequencies(p: &DiscreteSupport) -> [f64; 3] {
     [w[0], w[1], w[2]]
 }
 
+/// The frequencies of a receptance's peaks from `from_hz` on, Hz (local maxima of `|H|`).
+pub fn peaks(r: &[(f64, f64)], from_hz: f64) -> Vec<f64> {
+    r.windows(3)
+        .filter(|w| w[0].0 >= from_hz && w[1].1 > w[0].1 && w[1].1 >= w[2].1)
+        .map(|w| w[1].0)
+        .collect()
+}
+
 /// The vertical point receptance of one rail with both rails struck alike at `offset` m from
 /// a sleeper (0: over it, half the spacing: mid-span), m/N, at the frequencies of an impulse
 /// response of `seconds` at step `dt`: `(f Hz, |H|)` from 0 to `f_max`.
