@@ -16,6 +16,8 @@ mod common;
 mod contact;
 #[path = "dataset.rs"]
 mod dataset;
+#[path = "dipped_joint.rs"]
+mod dipped_joint;
 #[path = "docs.rs"]
 mod docs;
 #[path = "dynamics.rs"]

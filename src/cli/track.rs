@@ -207,6 +207,16 @@ fn print_summary(track: &Track) {
                 d.gradient() * 1e3
             );
         }
+        if let Some(j) = w.joints {
+            println!(
+                "  dipped joints every {} m from {} m: 2α {} mrad, {:.2} mm deep over {} m",
+                j.spacing,
+                j.first,
+                j.angle * 1e3,
+                j.depth() * 1e3,
+                j.length
+            );
+        }
     }
 }
 

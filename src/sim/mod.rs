@@ -450,6 +450,12 @@ impl<'a> Simulation<'a> {
         &self.states
     }
 
+    /// Per wheel (as [`Simulation::wheels`]): the rail under it on a compliant track, from its
+    /// unloaded place; zero on a rigid one.
+    pub fn rails(&self) -> &[RailState] {
+        &self.rails
+    }
+
     /// Along-track position of each body, m.
     pub fn body_s(&self) -> &[f64] {
         &self.body_s

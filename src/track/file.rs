@@ -35,6 +35,7 @@ struct TrackFile {
     rail_support: Option<super::support::RailSupportFile>,
     roughness: Option<super::short_wave::RoughnessFile>,
     welds: Option<super::short_wave::WeldsFile>,
+    joints: Option<super::short_wave::JointsFile>,
 }
 
 fn default_rail_spacing() -> f64 {
@@ -138,7 +139,7 @@ pub struct TrackSpec {
     /// Rails as beams on discrete sleepers (`[rail_support] model = "discrete"`); None
     /// otherwise. At most one of the two is set ([`TrackSpec::set_rail_model`]).
     pub discrete_rails: Option<super::discrete::DiscreteSupport>,
-    /// Rail roughness and weld dips (`[roughness]`, `[welds]`), if any.
+    /// Rail roughness, weld dips and dipped joints (`[roughness]`, `[welds]`, `[joints]`), if any.
     pub short_waves: Option<super::short_wave::ShortWaveSpec>,
 }
 
@@ -410,8 +411,11 @@ impl TrackSpec {
 
         let short_waves = super::short_wave::from_file(
             path,
-            raw.roughness.as_ref(),
-            raw.welds.as_ref(),
+            super::short_wave::Tables {
+                roughness: raw.roughness.as_ref(),
+                welds: raw.welds.as_ref(),
+                joints: raw.joints.as_ref(),
+            },
             length,
             irregularity.map(|i| (i.min_wavelength, i.seed, i.smooth_start, i.fade_in)),
         )?;

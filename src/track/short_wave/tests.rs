@@ -10,6 +10,7 @@ fn spec(filter: bool) -> ShortWaveSpec {
             seed: 7,
         }),
         welds: None,
+        joints: None,
         smooth_start: 0.0,
         fade_in: 0.0,
     }
@@ -76,12 +77,16 @@ fn parse(extra: &str) -> Result<Option<ShortWaveSpec>> {
     struct T {
         roughness: Option<RoughnessFile>,
         welds: Option<WeldsFile>,
+        joints: Option<JointsFile>,
     }
     let t: T = toml::from_str(&text).unwrap();
     from_file(
         Path::new("t.toml"),
-        t.roughness.as_ref(),
-        t.welds.as_ref(),
+        Tables {
+            roughness: t.roughness.as_ref(),
+            welds: t.welds.as_ref(),
+            joints: t.joints.as_ref(),
+        },
         2000.0,
         Some((1.0, 3, 20.0, 50.0)),
     )
@@ -100,6 +105,18 @@ fn a_track_files_tables_are_read_with_their_defaults_and_bad_keys_refused() {
     );
     assert_eq!(s.welds.unwrap().spacing, 100.0);
     assert_eq!(s.shortest_wavelength(), 0.1);
+    let j = parse("[joints]\nangle_mrad = 20.0").unwrap().unwrap();
+    assert_eq!(
+        j.joints,
+        Some(Joints {
+            spacing: 25.0,
+            first: 25.0,
+            angle: 0.02,
+            length: 2.0
+        })
+    );
+    assert_eq!((j.roughness, j.welds), (None, None));
+    assert_eq!(j.shortest_wavelength(), 0.05);
     for (bad, field) in [
         ("[roughness]\nspectrum = \"iso\"", "roughness.spectrum"),
         (
@@ -115,6 +132,17 @@ fn a_track_files_tables_are_read_with_their_defaults_and_bad_keys_refused() {
             "[welds]\nspacing_m = 10.0\nlength_m = 6.0",
             "welds.length_m",
         ),
+        ("[joints]\n", "joints.angle_mrad"),
+        ("[joints]\nangle_mrad = 80.0", "joints.angle_mrad"),
+        (
+            "[joints]\nangle_mrad = 10.0\nlength_m = 20.0",
+            "joints.length_m",
+        ),
+        (
+            "[joints]\nangle_mrad = 10.0\nfirst_m = -1.0",
+            "joints.first_m",
+        ),
+        ("[joints]\nangle_mrad = 10.0\ndepth_mm = 1.0", "depth_mm"),
     ] {
         let e = parse(bad).unwrap_err().to_string();
         assert!(e.contains(field) && e.contains("t.toml"), "{bad}: {e}");
