@@ -111,7 +111,6 @@ fn jenkins_p2(angle: f64, speed: f64, mu: f64) -> f64 {
 /// 60 Hz) it moves with them: the unsprung mass of a wheel is half the wheelset's and half a
 /// side frame's (860 kg); at P1 (about 500 Hz) the side frame stays behind (650 kg).
 #[test]
-#[ignore = "release: cargo test --release -- --ignored"]
 fn a_dipped_joint_gives_jenkins_p1_and_p2_on_his_track() {
     let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
     let mass = |name: &str| v.bodies.iter().find(|b| b.name == name).unwrap().mass;

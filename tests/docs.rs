@@ -623,7 +623,7 @@ fn the_channel_table_is_the_recorders() {
         "assets/docs/channels.md is not `railforce channels --markdown`: regenerate its table"
     );
     // The recorder records this list (`Recorder::new` builds its columns from it).
-    assert_eq!(list.len(), 228, "time_s and 227 channels");
+    assert_eq!(list.len(), 244, "time_s and 243 channels");
     // A run in a train adds the couplers' channels, listed in their own table.
     let train = railforce::sim::channels::channels_of(&v, true);
     let full = railforce::sim::channels::markdown(

@@ -113,6 +113,19 @@ fn the_scene_reproduces_the_recorded_loads_and_the_page_is_self_contained() {
             }
         }
     }
+    // The rails under the wheels: on the lumped track each rail mass sits, on average over
+    // the run, where its spring carries the wheel's mean load, z = −Q/k.
+    let k = track.spec().rail_support.unwrap().vertical.stiffness;
+    for w in &scene.wheels {
+        assert_eq!(w.rail_z.len(), scene.time.len());
+        let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+        let (z, q) = (mean(&w.rail_z), mean(&w.force_q) * 1e3 / k * 1e3);
+        assert!(
+            (z + q).abs() < 0.02 * q,
+            "rail {z:.3} mm under a mean load of {q:.3} mm"
+        );
+        assert!(w.rail_y.iter().all(|y| y.abs() < 1.0), "{:?}", w.rail_y);
+    }
     let id = scene.identified.as_ref().unwrap();
     for j in 0..scene.time.len() {
         let (t, i) = (scene.traces.y[j], id.y[j]);

@@ -103,27 +103,40 @@
       const yq = q > 0 ? Math.abs(fy) / q : NaN;
       const angles = patches.map((p) => p[3].toFixed(0) + "°").join(" + ");
       g.fillText("Y " + fmt(fy, 1) + " kN   Q " + fmt(q, 1) + " kN   |Y|/Q " + (isFinite(yq) ? yq.toFixed(2) : "—"), x0 + 12, H - 30);
-      g.fillText("shift " + fmt(y, 1) + " mm   " + (patches.length === 2 ? "two-point contact " : "contact ") + (angles || "none (lifted)"), x0 + 12, H - 10);
+      const rail = railAt(side), bent = rail ? "   rail z " + fmt(rail[1], 2) + " mm, y " + fmt(rail[0], 2) + " mm" : "";
+      g.fillText("shift " + fmt(y, 1) + " mm   " + (patches.length === 2 ? "two-point contact " : "contact ") + (angles || "none (lifted)") + bent, x0 + 12, H - 10);
       g.strokeStyle = COL.grid; g.beginPath(); g.moveTo(W, 0); g.lineTo(W, H); g.stroke();
     }
     $("cross-note").textContent = "True profile shapes and positions, magnified 4 px/mm (no exaggeration). " +
       "Pink: each contact patch's normal force from the rail (length and dot ∝ load); the inset: the wheel's resultant Q (blue) and Y (orange). " +
-      "Wheelset shift is relative to each rail (irregularity removed); roll " + fmt(S.wheels[0].roll[frame], 2) + " mrad.";
+      "Wheelset shift is relative to each rail (irregularity and the rail's own deflection removed); roll " + fmt(S.wheels[0].roll[frame], 2) + " mrad.";
   }
 
   // ---- the whole wheelset, schematic: shift and roll exaggerated so a class can see them ----
+  // the rails' deflection under the wheels (compliant track), mm, [left, right]: [y, z] each
+  const RAIL_SINK = 10;
+  function railAt(side) {
+    const w = S.wheels[side];
+    return w.rail_z.length ? [w.rail_y[frame], w.rail_z[frame]] : null;
+  }
   const AXLE_SHIFT = 5, AXLE_ROLL = 20;
   function drawAxle() {
     const [c, g] = ctx2d("axle");
-    const k = 0.55, cx = c.width / 2, base = 70; // px per mm at the rail tops
+    const k = 0.55, cx = c.width / 2, base = 66; // px per mm at the rail tops
     const ws = S.bodies.find((b) => b.kind === "wheelset");
     const y = ws ? ws.y[frame] : 0.5 * (S.wheels[0].y[frame] + S.wheels[1].y[frame]);
     const phi = S.wheels[0].roll[frame] / 1000 * AXLE_ROLL;
     const hg = S.profiles.half_gauge, r = 22; // wheel drawn 44 px high
+    const rails = [railAt(0), railAt(1)];
+    // each rail where its deflection puts it: down ×RAIL_SINK, across ×AXLE_SHIFT (as the wheelset)
+    const sink = (i) => (rails[i] ? -rails[i][1] * RAIL_SINK : 0);
     g.fillStyle = COL.rail;
-    for (const s of [1, -1]) g.fillRect(cx - (s * (hg + 35)) * k - 36 * k, base, 72 * k, 14);
+    [1, -1].forEach((s, i) => {
+      const dy = rails[i] ? rails[i][0] * AXLE_SHIFT * k : 0;
+      g.fillRect(cx - (s * (hg + 35)) * k - 36 * k - dy, base + sink(i), 72 * k, 14);
+    });
     g.strokeStyle = COL.grid; g.setLineDash([4, 4]); g.beginPath(); g.moveTo(cx, 4); g.lineTo(cx, c.height - 4); g.stroke(); g.setLineDash([]);
-    g.save(); g.translate(cx - y * AXLE_SHIFT * k, base - r); g.rotate(phi);
+    g.save(); g.translate(cx - y * AXLE_SHIFT * k, base - r + 0.5 * (sink(0) + sink(1))); g.rotate(phi);
     g.strokeStyle = COL.ink; g.lineWidth = 5; g.beginPath(); g.moveTo(-(hg + 70) * k, 0); g.lineTo((hg + 70) * k, 0); g.stroke();
     g.fillStyle = COL.wheel; g.strokeStyle = COL.ink; g.lineWidth = 1.5;
     for (const s of [1, -1]) { const xw = -s * (hg + 35) * k; g.fillRect(xw - 40 * k, -r, 80 * k, 2 * r); g.strokeRect(xw - 40 * k, -r, 80 * k, 2 * r); }
@@ -131,6 +144,8 @@
     g.fillStyle = COL.ink; g.font = "13px system-ui, sans-serif";
     g.fillText("whole wheelset, schematic: shift ×" + AXLE_SHIFT + " (" + fmt(y, 1) + " mm from the track centre), roll ×" + AXLE_ROLL + " (" + fmt(S.wheels[0].roll[frame], 2) + " mrad)", 8, 16);
     g.fillText("left", 8, base + 12); g.fillText("right", c.width - 40, base + 12);
+    g.fillText(rails[0] ? "rails under the wheels, down ×" + RAIL_SINK + ": left " + fmt(rails[0][1], 2) + " mm, right " + fmt(rails[1][1], 2) +
+      " mm vertical; " + fmt(rails[0][0], 2) + " / " + fmt(rails[1][0], 2) + " mm lateral" : "rigid track: the rails do not deflect", 200, c.height - 4);
   }
 
   // ---- plan view: track map above, the wagon in the track's (unrolled) frame below ----

@@ -63,7 +63,7 @@ enum Command {
     /// The channels a run records: every column's name, unit and meaning, in file order.
     ///
     /// The recorder's own list for the vehicle: time and track position, the paper's 21
-    /// inputs, every wheel's forces and contact, every body's motion, every suspension
+    /// inputs, every wheel's forces and contact and its rail's deflection, every body's motion, every suspension
     /// element's deflection and the wagon's mass. `--markdown` prints the table of
     /// assets/docs/channels.md.
     #[command(

@@ -101,7 +101,8 @@ pub enum ChannelKind {
     InputNoisy,
     /// A force of the label wheel (FL, FQ).
     Label,
-    /// A quantity of one wheel (force, contact, creepage): not measurable on board.
+    /// A quantity of one wheel (force, contact, creepage, the rail's deflection under it): not
+    /// measurable on board.
     Wheel,
     /// A body signal (acceleration, rate, track-relative position or angle).
     Body,

@@ -48,7 +48,7 @@ pub(super) const BODY_SIGNALS: [(&str, &str, &str); 10] = [
 
 /// The signals recorded for every wheel (per-wheel creepages are named `xi_*` so they never
 /// clash with the paper's `w1l_creep_*` inputs): suffix, unit, meaning.
-pub(super) const WHEEL_SIGNALS: [(&str, &str, &str); 7] = [
+pub(super) const WHEEL_SIGNALS: [(&str, &str, &str); 9] = [
     (
         "force_y",
         "N",
@@ -64,6 +64,16 @@ pub(super) const WHEEL_SIGNALS: [(&str, &str, &str); 7] = [
     ("xi_x", "1", "longitudinal creepage"),
     ("xi_y", "1", "lateral creepage"),
     ("xi_spin", "1/m", "spin creepage"),
+    (
+        "rail_y",
+        "m",
+        "the rail's lateral deflection under the wheel, track axes (+ left; 0 on a rigid track)",
+    ),
+    (
+        "rail_z",
+        "m",
+        "the rail's vertical deflection under the wheel from its unloaded place (+ up; 0 on a rigid track)",
+    ),
 ];
 
 /// What each of the paper's 21 inputs measures (X1 … X21, assets/docs/physics.md §5).
@@ -92,7 +102,7 @@ const PAPER_MEANINGS: [&str; 21] = [
 ];
 
 /// Every channel a run of `v` records, in column order: time and track position, the
-/// paper's 21 (vehicles with a sensor layout), every wheel's forces and contact, every
+/// paper's 21 (vehicles with a sensor layout), every wheel's forces and contact and its rail's deflection, every
 /// body's motion, every suspension element's deflection, and the vehicle's mass.
 pub fn channels(v: &Vehicle) -> Vec<Channel> {
     let ch = |name: String, unit: &'static str, meaning: String| Channel {

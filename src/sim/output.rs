@@ -214,7 +214,7 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
             put(x);
         }
     }
-    for w in &sim.wheels {
+    for (w, rail) in sim.wheels.iter().zip(sim.rails()) {
         for x in [
             w.y,
             w.q,
@@ -223,6 +223,8 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
             w.creepage.x,
             w.creepage.y,
             w.creepage.spin,
+            rail.y,
+            rail.z,
         ] {
             put(x);
         }

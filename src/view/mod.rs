@@ -107,7 +107,8 @@ pub struct PlanBody {
 }
 
 /// One wheel of the leading wheelset, frame by frame, relative to its own rail (irregularity
-/// removed): what the cross-section needs.
+/// and the rail's deflection removed), and the rail's deflection: what the cross-section and
+/// the wheelset's schematic need.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct WheelFrames {
     /// Lateral shift of the wheelset centre from this rail's nominal place, mm.
@@ -124,6 +125,12 @@ pub struct WheelFrames {
     pub force_y: Vec<f64>,
     /// Vertical force Q, kN.
     pub force_q: Vec<f64>,
+    /// The rail's lateral deflection under the wheel (+ left), mm; empty where the run did not
+    /// record it.
+    pub rail_y: Vec<f64>,
+    /// The rail's vertical deflection under the wheel from its unloaded place (+ up), mm;
+    /// empty where the run did not record it.
+    pub rail_z: Vec<f64>,
 }
 
 /// Y, Q and Y/Q of one wheel.
@@ -263,7 +270,8 @@ impl Scene {
         let label_key = label.to_ascii_lowercase();
 
         // The leading wheelset's wheels relative to their rails, as a run gives them to the
-        // contact evaluation (the compliant rails' own deflection is not recorded: left out).
+        // contact evaluation: irregularity and, on a compliant track, the rail's own deflection
+        // removed (a file written before the deflection was recorded: taken as zero).
         let ws_y = column(source, cols, &format!("{lead_name}_y_rel"))?;
         let ws_roll = column(source, cols, &format!("{lead_name}_roll"))?;
         let ws_yaw = column(source, cols, &format!("{lead_name}_yaw"))?;
@@ -276,12 +284,19 @@ impl Scene {
             let w = if k == 0 { "w1l" } else { "w1r" };
             let fy = column(source, cols, &format!("{w}_force_y"))?;
             let fq = column(source, cols, &format!("{w}_force_z"))?;
+            let deflection = |axis: &str| column(source, cols, &format!("{w}_rail_{axis}")).ok();
+            let (rail_y, rail_z) = (deflection("y"), deflection("z"));
             let out = &mut wheels[k];
             for &i in &rows {
                 let rails = inp.track.at(s_col[i] + x_lead).rails;
                 let irr = if k == 0 { rails.left_y } else { rails.right_y };
+                let ry = rail_y.map_or(0.0, |r| r[i]);
                 let mut wr = WheelOnRail::rolling(side, 0.0, geo.nominal_radius, 0.0, mass);
-                wr.y = (ws_y[i] - irr).clamp(-0.039, 0.039);
+                wr.y = (ws_y[i] - irr - ry).clamp(-0.039, 0.039);
+                if let (Some(_), Some(rz)) = (rail_y, rail_z) {
+                    out.rail_y.push(round(ry * 1e3, 3));
+                    out.rail_z.push(round(rz[i] * 1e3, 3));
+                }
                 wr.roll = ws_roll[i];
                 wr.yaw = ws_yaw[i];
                 let load = fq[i].max(1.0);

@@ -43,7 +43,7 @@ pub fn html(scene: &Scene) -> Result<String> {
 </div>
 <main>
   <section class="panel" id="cross-panel"><h2>Leading wheelset on its rails (seen from behind)</h2>
-    <canvas id="axle" width="1000" height="90"></canvas>
+    <canvas id="axle" width="1000" height="110"></canvas>
     <canvas id="cross" width="1000" height="420"></canvas>
     <p class="note" id="cross-note"></p></section>
   <section class="panel" id="plan-panel"><h2>Plan view: the wagon on the track</h2>
