@@ -110,6 +110,63 @@ fn saved_models_predict_the_same_after_loading() {
     }
 }
 
+/// Predictions shared out between threads, each on its own copy of the networks, are the
+/// single thread's bit for bit: for one network, for one with quantile heads, and for an
+/// ensemble (its spread too), whatever the number of windows and threads.
+#[test]
+fn predictions_on_several_threads_are_the_single_threads() {
+    let ds = synthetic(1, 300);
+    let q = TrainOptions {
+        quantile_heads: Some(0.9),
+        ..quick(1)
+    };
+    let gru = |seed: u64, dir: &str| {
+        let opts = TrainOptions { seed, ..quick(1) };
+        train(&ds, &spec(), ModelKind::Gru, &opts, &tmp(dir), &mut |_| {}).unwrap()
+    };
+    let members = vec![gru(3, "member1"), gru(4, "member2")];
+    let nets = [
+        train(
+            &ds,
+            &spec(),
+            ModelKind::CnnBiLstm,
+            &quick(1),
+            &tmp("one"),
+            &mut |_| {},
+        )
+        .unwrap(),
+        train(
+            &ds,
+            &spec(),
+            ModelKind::CnnBiLstm,
+            &q,
+            &tmp("quantiles"),
+            &mut |_| {},
+        )
+        .unwrap(),
+        railforce::learn::uncertainty::join(members, &ds, &tmp("ensemble")).unwrap(),
+    ];
+    let (w, c) = (8, 3);
+    let n = 2 * 1024 + 77;
+    let x: Vec<f32> = (0..n * w * c).map(|i| ((i as f32) * 0.37).sin()).collect();
+    for mut m in nets {
+        let one = m.predict_spread(&x, n);
+        for threads in [2, 3, 8] {
+            let (p, s) = m.predict_spread_on(&x, n, threads);
+            assert!(
+                p.iter()
+                    .zip(&one.0)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
+            assert_eq!(p.len(), one.0.len());
+            assert_eq!(s.is_some(), one.1.is_some(), "{threads} threads");
+            if let (Some(s), Some(o)) = (s, &one.1) {
+                assert!(s.iter().zip(o).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+        }
+    }
+}
+
 #[test]
 fn same_seed_same_weights_and_resume_continues_exactly() {
     let ds = synthetic(2, 300);

@@ -394,7 +394,7 @@ pub fn identify_with_bands(
         for s in first..last {
             x.extend_from_slice(&rows[s * c..(s + w) * c]);
         }
-        let (m, sp) = model.predict_spread(&x, last - first);
+        let (m, sp) = model.predict_spread_on(&x, last - first, crate::dataset::default_jobs());
         out.extend(m);
         if let Some(sp) = sp {
             spread.extend(sp);

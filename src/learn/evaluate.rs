@@ -30,7 +30,7 @@ pub type PredictionRow = (String, u64, f64, Vec<(f64, f64)>);
 pub struct Evaluation {
     /// Per target.
     pub metrics: Vec<Metrics>,
-    /// Inference windows per second.
+    /// Inference windows per second, on every core ([`crate::dataset::default_jobs`]).
     pub windows_per_s: f64,
     /// Rows of the prediction table: condition, seed, time, then (true, predicted) in N per target.
     pub rows: Vec<PredictionRow>,
@@ -145,7 +145,8 @@ pub fn evaluate(model: &mut Model, ds: &DataSet, part: EvalPart) -> Result<Evalu
     let prep = prepare(ds, &spec, Some((&stats.0, &stats.1)))?;
     let (x, y) = prep.test.all();
     let t0 = Instant::now();
-    let (p, spread) = model.predict_spread(&x, prep.test.len());
+    // Every core (the experiments evaluate after their trainings, the cores free).
+    let (p, spread) = model.predict_spread_on(&x, prep.test.len(), crate::dataset::default_jobs());
     let windows_per_s = prep.test.len() as f64 / t0.elapsed().as_secs_f64().max(1e-9);
     let half_widths = model.meta.calibration.as_ref().map(|cal| {
         let o = prep.test.outputs;

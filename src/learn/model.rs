@@ -157,6 +157,50 @@ pub struct Model {
 
 const MAGIC: &[u8; 8] = b"RFWEIGHT";
 
+/// The prediction and spread of `engine` with its ensemble `members` for `n` windows `x`, each
+/// network on up to `threads` threads ([`Model::predict_spread`]).
+fn spread_of(
+    engine: &mut Engine,
+    members: &mut [Engine],
+    x: &[f32],
+    n: usize,
+    threads: usize,
+) -> (Vec<f32>, Option<Vec<f32>>) {
+    let run = |e: &mut Engine| match e {
+        Engine::Net(net) => {
+            let all = net.predict_all_on(x, n, threads);
+            match net.config.quantiles {
+                Some(c) => quantile_spread(&all, net.config.outputs / 3, c),
+                None => (net.means(all), None),
+            }
+        }
+        Engine::Classical(c) => (c.predict(x, n), None),
+    };
+    let first = run(engine);
+    if members.is_empty() {
+        return first;
+    }
+    let mut all = vec![first];
+    for m in members.iter_mut() {
+        all.push(run(m));
+    }
+    let k = all.len() as f32;
+    let mean: Vec<f32> = (0..all[0].0.len())
+        .map(|i| all.iter().map(|p| p.0[i]).sum::<f32>() / k)
+        .collect();
+    let spread = (0..mean.len())
+        .map(|i| {
+            let own: f32 = all
+                .iter()
+                .filter_map(|p| p.1.as_ref().map(|s| s[i] * s[i]))
+                .sum();
+            let between: f32 = all.iter().map(|p| (p.0[i] - mean[i]).powi(2)).sum();
+            ((between + own) / k).sqrt()
+        })
+        .collect();
+    (mean, Some(spread))
+}
+
 impl Model {
     /// Standardised predictions `[n, outputs]` for windows `x[n, window, channels]` (an
     /// ensemble's mean).
@@ -170,36 +214,18 @@ impl Model {
     /// disagreement plus their own heads' σ where they have heads; Lakshminarayanan et al.
     /// 2017, eq. 5); one plain network gives none.
     pub fn predict_spread(&mut self, x: &[f32], n: usize) -> (Vec<f32>, Option<Vec<f32>>) {
-        let run = |e: &mut Engine| match e {
-            Engine::Net(net) => match net.config.quantiles {
-                Some(c) => quantile_spread(&net.predict_all(x, n), net.config.outputs / 3, c),
-                None => (net.predict(x, n), None),
-            },
-            Engine::Classical(c) => (c.predict(x, n), None),
-        };
-        let first = run(&mut self.engine);
-        if self.members.is_empty() {
-            return first;
-        }
-        let mut all = vec![first];
-        for m in &mut self.members {
-            all.push(run(m));
-        }
-        let k = all.len() as f32;
-        let mean: Vec<f32> = (0..all[0].0.len())
-            .map(|i| all.iter().map(|p| p.0[i]).sum::<f32>() / k)
-            .collect();
-        let spread = (0..mean.len())
-            .map(|i| {
-                let own: f32 = all
-                    .iter()
-                    .filter_map(|p| p.1.as_ref().map(|s| s[i] * s[i]))
-                    .sum();
-                let between: f32 = all.iter().map(|p| (p.0[i] - mean[i]).powi(2)).sum();
-                ((between + own) / k).sqrt()
-            })
-            .collect();
-        (mean, Some(spread))
+        spread_of(&mut self.engine, &mut self.members, x, n, 1)
+    }
+
+    /// [`Model::predict_spread`] with each network's windows shared out between up to
+    /// `threads` threads ([`Network::predict_all_on`]): the same numbers bit for bit.
+    pub fn predict_spread_on(
+        &mut self,
+        x: &[f32],
+        n: usize,
+        threads: usize,
+    ) -> (Vec<f32>, Option<Vec<f32>>) {
+        spread_of(&mut self.engine, &mut self.members, x, n, threads)
     }
 
     /// Writes the model directory (atomically file by file).

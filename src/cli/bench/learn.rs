@@ -117,6 +117,29 @@ pub fn infer_rate(architecture: Architecture, seconds: f64) -> f64 {
     n as f64 / t0.elapsed().as_secs_f64()
 }
 
+/// Inference windows per second of the CNN-BiLSTM on `threads` threads (the evaluation path
+/// of `evaluate`, `experiment` and `identify`: [`Network::predict_all_on`]) and on one, in
+/// alternating rounds of 8 192 windows for about `seconds` in all: `(one, threads)`.
+pub fn infer_rate_on(threads: usize, seconds: f64) -> (f64, f64) {
+    let mut net = Network::new(bench_config(Architecture::CnnBiLstm));
+    let n = 8 * 1024;
+    let big = windows(n);
+    let (mut one, mut many) = (0.0, 0.0);
+    let t0 = Instant::now();
+    let mut rounds = 0usize;
+    while t0.elapsed().as_secs_f64() < seconds || rounds == 0 {
+        let t = Instant::now();
+        std::hint::black_box(net.predict_all(&big, n));
+        one += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        std::hint::black_box(net.predict_all_on(&big, n, threads));
+        many += t.elapsed().as_secs_f64();
+        rounds += 1;
+    }
+    let done = (rounds * n) as f64;
+    (done / one, done / many)
+}
+
 /// Training rates with gradients by burn (`engines`: `burn-cpu`, `burn-gpu`) for the four
 /// networks at each batch size, each beside the fused engine at the same batch measured in the
 /// same run (the reference the ratio is read against).

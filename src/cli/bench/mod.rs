@@ -166,6 +166,14 @@ pub fn run(args: BenchArgs) -> Result<()> {
                     "(against PyTorch in the same run, alternating rounds: --against-torch; needs PyTorch)"
                 );
             }
+            let cores = railforce::dataset::default_jobs();
+            if cores > 1 {
+                let (one, many) = learn::infer_rate_on(cores, 2.0 * seconds);
+                println!(
+                    "evaluation path (cnn-bilstm, 8 192 windows, alternating rounds): {many:.0} win/s on {cores} threads against {one:.0} on one, {:.2}×",
+                    many / one
+                );
+            }
             let lat = learn::streaming_latency_us(5000);
             println!(
                 "streaming identification (cnn-bilstm, FL + FQ): {lat:.1} µs per new sample, {:.0}× inside the 5 ms sampling interval",

@@ -180,6 +180,14 @@ impl Network {
         }
     }
 
+    /// A copy of the weights with buffers of its own, for a second thread's predictions (the
+    /// dropout stream starts afresh: a twin is for evaluation).
+    pub fn twin(&self) -> Network {
+        let mut n = Network::new(self.config.clone());
+        n.params = self.params.clone();
+        n
+    }
+
     /// Re-seeds the dropout stream (the trainer does so per epoch for resumable runs).
     pub fn reseed_dropout(&mut self, seed: u64) {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
@@ -414,6 +422,12 @@ impl Network {
     /// (the mean heads of a network with quantile heads).
     pub fn predict(&mut self, x: &[f32], batch: usize) -> Vec<f32> {
         let all = self.predict_all(x, batch);
+        self.means(all)
+    }
+
+    /// The mean heads of every head's output `all` (`[B, outputs]`, as
+    /// [`Network::predict_all`] gives it): itself without quantile heads.
+    pub fn means(&self, all: Vec<f32>) -> Vec<f32> {
         if self.config.quantiles.is_none() {
             return all;
         }
@@ -424,17 +438,49 @@ impl Network {
     }
 
     /// Every head's output for `x[B, window, channels]` in evaluation mode, `[B, outputs]`, in
-    /// chunks of 1024 windows.
+    /// chunks of [`PREDICT_CHUNK`] windows.
     pub fn predict_all(&mut self, x: &[f32], batch: usize) -> Vec<f32> {
         let per = self.config.window * self.config.channels;
         let mut out = Vec::with_capacity(batch * self.config.outputs);
-        for chunk in x.chunks(per * 1024) {
+        for chunk in x.chunks(per * PREDICT_CHUNK) {
             let n = chunk.len() / per;
             out.extend_from_slice(self.forward(chunk, n, false));
         }
         out
     }
+
+    /// [`Network::predict_all`] with the windows shared out between up to `threads` threads in
+    /// runs of whole [`PREDICT_CHUNK`]s, each on its own [`Network::twin`]: every chunk is the
+    /// one a single thread takes, through the same code, so the output is the same bit for
+    /// bit. Fewer than two chunks stay on this thread.
+    pub fn predict_all_on(&mut self, x: &[f32], batch: usize, threads: usize) -> Vec<f32> {
+        let chunks = batch.div_ceil(PREDICT_CHUNK);
+        let threads = threads.min(chunks);
+        if threads < 2 {
+            return self.predict_all(x, batch);
+        }
+        let per = self.config.window * self.config.channels;
+        let share = chunks.div_ceil(threads) * PREDICT_CHUNK * per;
+        let mut twins: Vec<Network> = (1..threads).map(|_| self.twin()).collect();
+        std::thread::scope(|scope| {
+            let mut parts = x.chunks(share);
+            let first = parts.next().unwrap_or_default();
+            let handles: Vec<_> = parts
+                .zip(twins.iter_mut())
+                .map(|(xs, net)| scope.spawn(move || net.predict_all(xs, xs.len() / per)))
+                .collect();
+            let mut out = self.predict_all(first, first.len() / per);
+            for h in handles {
+                out.extend(h.join().expect("a prediction thread panicked"));
+            }
+            out
+        })
+    }
 }
+
+/// Windows a network predicts at a time ([`Network::predict_all`]), and the unit in which
+/// [`Network::predict_all_on`] shares them out between threads.
+pub const PREDICT_CHUNK: usize = 1024;
 
 /// Windows per chunk of the evaluation path: the stem's activations of one chunk
 /// (64 × 20 × 128 floats, 640 KiB) stay in the L2 cache.
