@@ -113,7 +113,8 @@
   }
 
   // ---- the whole wheelset, schematic: shift and roll exaggerated so a class can see them ----
-  // the rails' deflection under the wheels (compliant track), mm, [left, right]: [y, z] each
+  // the rails' deflection under the wheels (compliant track), mm, [left, right]: [y, z] each;
+  // drawn at RAIL_SINK px per mm (the schematic's lengths are 0.55 px per mm), clamped
   const RAIL_SINK = 10;
   function railAt(side) {
     const w = S.wheels[side];
@@ -129,7 +130,7 @@
     const hg = S.profiles.half_gauge, r = 22; // wheel drawn 44 px high
     const rails = [railAt(0), railAt(1)];
     // each rail where its deflection puts it: down ×RAIL_SINK, across ×AXLE_SHIFT (as the wheelset)
-    const sink = (i) => (rails[i] ? -rails[i][1] * RAIL_SINK : 0);
+    const sink = (i) => (rails[i] ? Math.max(-12, Math.min(16, -rails[i][1] * RAIL_SINK)) : 0);
     g.fillStyle = COL.rail;
     [1, -1].forEach((s, i) => {
       const dy = rails[i] ? rails[i][0] * AXLE_SHIFT * k : 0;
@@ -144,8 +145,8 @@
     g.fillStyle = COL.ink; g.font = "13px system-ui, sans-serif";
     g.fillText("whole wheelset, schematic: shift ×" + AXLE_SHIFT + " (" + fmt(y, 1) + " mm from the track centre), roll ×" + AXLE_ROLL + " (" + fmt(S.wheels[0].roll[frame], 2) + " mrad)", 8, 16);
     g.fillText("left", 8, base + 12); g.fillText("right", c.width - 40, base + 12);
-    g.fillText(rails[0] ? "rails under the wheels, down ×" + RAIL_SINK + ": left " + fmt(rails[0][1], 2) + " mm, right " + fmt(rails[1][1], 2) +
-      " mm vertical; " + fmt(rails[0][0], 2) + " / " + fmt(rails[1][0], 2) + " mm lateral" : "rigid track: the rails do not deflect", 200, c.height - 4);
+    g.fillText(rails[0] ? "rails under the wheels, " + RAIL_SINK + " px/mm down: left " + fmt(rails[0][1], 2) + " mm, right " + fmt(rails[1][1], 2) +
+      " mm vertical; " + fmt(rails[0][0], 2) + " / " + fmt(rails[1][0], 2) + " mm lateral" : "rail deflection not recorded (a run from before it was a channel)", 200, c.height - 4);
   }
 
   // ---- plan view: track map above, the wagon in the track's (unrolled) frame below ----

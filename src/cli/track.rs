@@ -209,7 +209,7 @@ fn print_summary(track: &Track) {
         }
         if let Some(j) = w.joints {
             println!(
-                "  dipped joints every {} m from {} m: 2α {} mrad, {:.2} mm deep over {} m",
+                "  dipped joints every {} m from {} m: 2α {:.1} mrad, {:.2} mm deep over {} m",
                 j.spacing,
                 j.first,
                 j.angle * 1e3,

@@ -340,8 +340,8 @@ impl Recording {
     }
 }
 
-/// Runs a simulation: settles, then records `duration` seconds in memory (about 0.3 MB per
-/// simulated second for the C80's 228 columns). `progress` receives the fraction done.
+/// Runs a simulation: settles, then records `duration` seconds in memory (about 0.4 MB per
+/// simulated second for the C80's 244 columns). `progress` receives the fraction done.
 pub fn record(sim: &mut Simulation, mut progress: impl FnMut(f64)) -> Result<Recording> {
     let t0 = std::time::Instant::now();
     sim.settle()?;

@@ -20,9 +20,10 @@ pub struct Joints {
     pub length: f64,
 }
 
-/// What a kink counts as for the step, m: it holds every wavelength, and the wheel's contact
-/// patch (12–15 mm long) filters the shorter ones; 50 mm puts P1's band (about 0.5–1 kHz) inside
-/// what the step follows at any speed up to 144 km/h (a choice).
+/// What a kink counts as for the step, m (a choice): it holds every wavelength, and the wheel's
+/// contact patch (12–15 mm long) filters the shorter ones. Below 144 km/h the short waves' cap
+/// of 62.5 µs governs (20 steps a period up to 800 Hz, P1 on the lumped track near 470 Hz);
+/// above it, 50 mm keeps 20 steps a period of its passing.
 const KINK_WAVELENGTH: f64 = 0.05;
 
 impl Joints {

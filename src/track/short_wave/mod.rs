@@ -269,7 +269,8 @@ pub const DEFAULT_WELD_LENGTH: f64 = 1.0;
 /// Joint spacing unless given, m: the 25 m standard rail of Chinese jointed track.
 pub const DEFAULT_JOINT_SPACING: f64 = 25.0;
 /// Length of a joint's dipped zone unless given, both rail ends, m (a choice: long enough
-/// that the ramps' curvature, 2α/L, loads an 860 kg wheel at 80 km/h by under 5 kN at 20 mrad).
+/// that the ramps' curvature, 2α/L, unloads an 800 kg wheel at 80 km/h by under 5 kN at
+/// 20 mrad).
 pub const DEFAULT_JOINT_LENGTH: f64 = 2.0;
 
 /// The short-wave tables of a track file.
@@ -380,10 +381,12 @@ pub(super) fn from_file(
                     ),
                 ));
             }
-            if !(first.is_finite() && first >= 0.0) {
+            if !(first.is_finite() && first >= 0.0 && first <= length) {
                 return Err(err(
                     "welds.first_m",
-                    format!("must be zero or positive, got {first}"),
+                    format!(
+                        "must be between 0 and the track's length ({length:.0} m), got {first}"
+                    ),
                 ));
             }
             Some(Welds {
@@ -394,7 +397,7 @@ pub(super) fn from_file(
             })
         }
     };
-    let joints = joints.map(|j| joints_from(j, &err)).transpose()?;
+    let joints = joints.map(|j| joints_from(j, length, &err)).transpose()?;
     Ok(Some(ShortWaveSpec {
         roughness,
         welds,
@@ -404,10 +407,10 @@ pub(super) fn from_file(
     }))
 }
 
-/// A `[joints]` table's joints, every key checked.
-fn joints_from(j: &JointsFile, err: &dyn Fn(&str, String) -> Error) -> Result<Joints> {
+/// A `[joints]` table's joints on a track `length` m long, every key checked.
+fn joints_from(j: &JointsFile, length: f64, err: &dyn Fn(&str, String) -> Error) -> Result<Joints> {
     let spacing = j.spacing_m.unwrap_or(DEFAULT_JOINT_SPACING);
-    let length = j.length_m.unwrap_or(DEFAULT_JOINT_LENGTH);
+    let (track, length) = (length, j.length_m.unwrap_or(DEFAULT_JOINT_LENGTH));
     let first = j.first_m.unwrap_or(spacing);
     if !(spacing.is_finite() && (1.0..=10_000.0).contains(&spacing)) {
         return Err(err(
@@ -437,10 +440,10 @@ fn joints_from(j: &JointsFile, err: &dyn Fn(&str, String) -> Error) -> Result<Jo
             ),
         ));
     }
-    if !(first.is_finite() && first >= 0.0) {
+    if !(first.is_finite() && first >= 0.0 && first <= track) {
         return Err(err(
             "joints.first_m",
-            format!("must be zero or positive, got {first}"),
+            format!("must be between 0 and the track's length ({track:.0} m), got {first}"),
         ));
     }
     Ok(Joints {

@@ -142,6 +142,11 @@ fn a_track_files_tables_are_read_with_their_defaults_and_bad_keys_refused() {
             "[joints]\nangle_mrad = 10.0\nfirst_m = -1.0",
             "joints.first_m",
         ),
+        (
+            "[joints]\nangle_mrad = 10.0\nfirst_m = 2500.0",
+            "joints.first_m",
+        ),
+        ("[welds]\nfirst_m = 2500.0", "welds.first_m"),
     ] {
         let e = parse(bad).unwrap_err().to_string();
         assert!(e.contains(field) && e.contains("t.toml"), "{bad}: {e}");
