@@ -360,33 +360,11 @@ pub(super) fn from_file(
             let depth = w.depth_mm.map_or(DEFAULT_WELD_DEPTH, |d| d * 1e-3);
             let len = w.length_m.unwrap_or(DEFAULT_WELD_LENGTH);
             let first = w.first_m.unwrap_or(spacing);
-            if !(spacing.is_finite() && (1.0..=10_000.0).contains(&spacing)) {
-                return Err(err(
-                    "welds.spacing_m",
-                    format!("must be between 1 and 10000 m, got {spacing}"),
-                ));
-            }
+            placed("welds", (spacing, first, len), 0.05, length, &err)?;
             if !(depth.is_finite() && depth > 0.0 && depth <= 5e-3) {
                 return Err(err(
                     "welds.depth_mm",
                     format!("must be above 0 and at most 5 mm, got {}", depth * 1e3),
-                ));
-            }
-            if !(len.is_finite() && len >= 0.05 && len <= 0.5 * spacing) {
-                return Err(err(
-                    "welds.length_m",
-                    format!(
-                        "must be between 0.05 m and half the spacing ({} m), got {len}",
-                        0.5 * spacing
-                    ),
-                ));
-            }
-            if !(first.is_finite() && first >= 0.0 && first <= length) {
-                return Err(err(
-                    "welds.first_m",
-                    format!(
-                        "must be between 0 and the track's length ({length:.0} m), got {first}"
-                    ),
                 ));
             }
             Some(Welds {
@@ -407,17 +385,46 @@ pub(super) fn from_file(
     }))
 }
 
+/// The placement keys of a `[welds]` or `[joints]` table (`table`): `spacing_m` 1–10 000 m,
+/// `length_m` of each dip from `shortest` m to half the spacing, `first_m` on the track
+/// (`track` m long).
+fn placed(
+    table: &str,
+    (spacing, first, length): (f64, f64, f64),
+    shortest: f64,
+    track: f64,
+    err: &dyn Fn(&str, String) -> Error,
+) -> Result<()> {
+    if !(spacing.is_finite() && (1.0..=10_000.0).contains(&spacing)) {
+        return Err(err(
+            &format!("{table}.spacing_m"),
+            format!("must be between 1 and 10000 m, got {spacing}"),
+        ));
+    }
+    if !(length.is_finite() && length >= shortest && length <= 0.5 * spacing) {
+        return Err(err(
+            &format!("{table}.length_m"),
+            format!(
+                "must be between {shortest} m and half the spacing ({} m), got {length}",
+                0.5 * spacing
+            ),
+        ));
+    }
+    if !(first.is_finite() && first >= 0.0 && first <= track) {
+        return Err(err(
+            &format!("{table}.first_m"),
+            format!("must be between 0 and the track's length ({track:.0} m), got {first}"),
+        ));
+    }
+    Ok(())
+}
+
 /// A `[joints]` table's joints on a track `length` m long, every key checked.
 fn joints_from(j: &JointsFile, length: f64, err: &dyn Fn(&str, String) -> Error) -> Result<Joints> {
     let spacing = j.spacing_m.unwrap_or(DEFAULT_JOINT_SPACING);
     let (track, length) = (length, j.length_m.unwrap_or(DEFAULT_JOINT_LENGTH));
     let first = j.first_m.unwrap_or(spacing);
-    if !(spacing.is_finite() && (1.0..=10_000.0).contains(&spacing)) {
-        return Err(err(
-            "joints.spacing_m",
-            format!("must be between 1 and 10000 m, got {spacing}"),
-        ));
-    }
+    placed("joints", (spacing, first, length), 0.2, track, err)?;
     let angle = j.angle_mrad.ok_or_else(|| {
         err(
             "joints.angle_mrad",
@@ -429,21 +436,6 @@ fn joints_from(j: &JointsFile, length: f64, err: &dyn Fn(&str, String) -> Error)
         return Err(err(
             "joints.angle_mrad",
             format!("must be above 0 and at most 50 mrad, got {angle}"),
-        ));
-    }
-    if !(length.is_finite() && length >= 0.2 && length <= 0.5 * spacing) {
-        return Err(err(
-            "joints.length_m",
-            format!(
-                "must be between 0.2 m and half the spacing ({} m), got {length}",
-                0.5 * spacing
-            ),
-        ));
-    }
-    if !(first.is_finite() && first >= 0.0 && first <= track) {
-        return Err(err(
-            "joints.first_m",
-            format!("must be between 0 and the track's length ({track:.0} m), got {first}"),
         ));
     }
     Ok(Joints {
