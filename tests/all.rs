@@ -58,6 +58,8 @@ mod short_waves;
 mod sklearn;
 #[path = "stability.rs"]
 mod stability;
+#[path = "step_guard.rs"]
+mod step_guard;
 #[path = "track.rs"]
 mod track;
 #[path = "train.rs"]

@@ -524,9 +524,9 @@ fn demo_runs_from_an_empty_folder() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A step too coarse for the wheel–rail contact makes the wheel jump off its rail at once:
-/// the run stops naming it a jump and the step, not a flange climb; and a step given coarser
-/// than short waves allow is refused with the step that follows them.
+/// A step too coarse for the vehicle's stiffest coupling is refused before the run starts,
+/// naming the longest step that holds it; and a step given coarser than short waves allow is
+/// refused with the step that follows them.
 #[test]
 fn a_burst_is_named_and_a_step_too_coarse_for_short_waves_refused() {
     let out = std::env::temp_dir().join(format!("railforce-burst-{}.csv", std::process::id()));
@@ -552,7 +552,7 @@ fn a_burst_is_named_and_a_step_too_coarse_for_short_waves_refused() {
     };
     let (ok, _, err) = run(&["--dt", "1e-3"]);
     assert!(
-        !ok && err.contains("a jump") && err.contains("finer --dt"),
+        !ok && err.contains("cannot follow") && err.contains("--dt below"),
         "{err}"
     );
     let (ok, _, err) = run(&["--dt", "5e-4", "--roughness", "cnossos_m"]);

@@ -87,7 +87,9 @@ enum Command {
     /// Simulate a vehicle on a track and record the 21 sensor channels, the forces of every
     /// wheel and the motion of every body at 200 Hz.
     ///
-    /// The run starts from static equilibrium, settles (not recorded), then records. A
+    /// The run starts from static equilibrium, settles (not recorded), then records. A step
+    /// its integrator cannot hold (a stiff mode growing from step to step at the start) is
+    /// refused before the first step, naming the mode and the longest step that holds it. A
     /// diverging run or a derailment (flange climb, or |Y/Q| above Nadal's limit for more
     /// than 50 ms) stops with a message naming the time and the wheel or body; nothing
     /// non-finite is ever written, and the CSV appears only when complete.

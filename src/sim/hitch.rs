@@ -110,6 +110,7 @@ struct Chord {
 }
 
 /// The train hitched to a run's carbody.
+#[derive(Clone)]
 pub struct Hitch {
     train: Train,
     /// The carbody.

@@ -130,7 +130,8 @@ impl SimConfig {
     }
 }
 
-/// A running simulation.
+/// A running simulation (a copy runs on from the same state: the step guard linearises a run's step on one).
+#[derive(Clone)]
 pub struct Simulation<'a> {
     vehicle: &'a Vehicle,
     track: &'a Track,

@@ -340,10 +340,12 @@ impl Recording {
     }
 }
 
-/// Runs a simulation: settles, then records `duration` seconds in memory (about 0.4 MB per
+/// Runs a simulation: refuses a step its integrator cannot hold ([`super::modes::guard`]),
+/// settles, then records `duration` seconds in memory (about 0.4 MB per
 /// simulated second for the C80's 244 columns). `progress` receives the fraction done.
 pub fn record(sim: &mut Simulation, mut progress: impl FnMut(f64)) -> Result<Recording> {
     let t0 = std::time::Instant::now();
+    super::modes::guard(sim)?;
     sim.settle()?;
     let mut rec = Recorder::new(sim);
     let duration = sim.config().duration;

@@ -228,6 +228,24 @@ fn dynamics(
         wk.textbook,
         verdict(dev < 0.01)
     );
+    println!(
+        "Step guard ({}, tangent, 80 km/h): the longest step each integrator holds at a run's start",
+        v.name
+    );
+    let tangent = railforce::track::Track::load(&super::builtin::resolve(std::path::Path::new(
+        "tracks/tangent.toml",
+    ))?)?;
+    for l in railforce::sim::modes::step_limits(&v, &tangent, 80.0 / 3.6)? {
+        let longest = l
+            .longest
+            .map_or("below 0.25 ms".into(), |d| format!("{:.3} ms", d * 1e3));
+        println!(
+            "  {:<24} own step {:.3} ms, holds up to {longest}  {}",
+            l.integrator.name(),
+            l.own * 1e3,
+            verdict(l.holds())
+        );
+    }
     fidelity(&v, empty, &mut verdict)?;
     train_checks(&mut verdict)?;
     if misses > 0 {

@@ -88,6 +88,101 @@ impl<'a> Linear<'a> {
         sim.hauling_integral = x[last];
     }
 
+    /// The simulation's state as `x` against the reference: the inverse of [`Linear::set`].
+    fn read(&self) -> DVector<f64> {
+        let n = self.len();
+        let sim = &self.sim;
+        let mut x = DVector::zeros(n);
+        for i in 0..self.bodies() {
+            let at = self.axes[i].transpose();
+            let st = &sim.states[i];
+            let blocks = [
+                at * (st.position - self.positions[i]),
+                at * (st.rotation * self.rotations[i].inverse()).scaled_axis(),
+                at * (st.velocity - self.velocities[i]),
+                at * (st.angular_velocity - self.omegas[i]),
+            ];
+            for (k, b) in blocks.iter().enumerate() {
+                for j in 0..3 {
+                    x[12 * i + 3 * k + j] = b[j];
+                }
+            }
+        }
+        let base = 12 * self.bodies();
+        if self.compliant {
+            for (k, (r, r0)) in sim.rails.iter().zip(&self.rails).enumerate() {
+                x[base + 4 * k] = r.y - r0.y;
+                x[base + 4 * k + 1] = r.vy - r0.vy;
+                x[base + 4 * k + 2] = r.z - r0.z;
+                x[base + 4 * k + 3] = r.vz - r0.vz;
+            }
+        }
+        x[n - 1] = sim.hauling_integral;
+        x
+    }
+
+    /// The state `x` against the reference after `steps` of the run's own steps from
+    /// reference + `x0` (the whole simulation copied first, and restored after).
+    pub(super) fn run_from(&mut self, x0: &DVector<f64>, steps: usize) -> Result<DVector<f64>> {
+        let start = self.sim.clone();
+        self.set(x0);
+        let mut out = Ok(());
+        for _ in 0..steps {
+            out = self.sim.step();
+            if out.is_err() {
+                break;
+            }
+        }
+        let x = self.read();
+        self.sim = start;
+        out.map(|_| x)
+    }
+
+    /// The run's own step as a linear map `x_{n+1} = Φ·x_n` about the reference, by central
+    /// differences: each column is the difference of two steps from the reference state
+    /// stepped by ± a small amount (the reference's motion over the step cancels). Every step
+    /// starts from a copy of the whole simulation (friction sliders, rails on sleepers, the
+    /// train); the states outside `x` (the beams' modes, the sliders) start each step where
+    /// the reference has them.
+    pub(super) fn step_matrix(&mut self) -> Result<DMatrix<f64>> {
+        let n = self.len();
+        let base = 12 * self.bodies();
+        let start = self.sim.clone();
+        let mut phi = DMatrix::zeros(n, n);
+        for j in 0..n {
+            let h = if j < base {
+                match j % 12 {
+                    0..=5 => 1e-6,
+                    _ => 1e-5,
+                }
+            } else if j < n - 1 {
+                match (j - base) % 4 {
+                    0 | 2 => 1e-7,
+                    _ => 1e-5,
+                }
+            } else {
+                1e-4
+            };
+            let mut ends = [DVector::zeros(0), DVector::zeros(0)];
+            for (end, sign) in ends.iter_mut().zip([1.0, -1.0]) {
+                self.sim = start.clone();
+                let mut x = DVector::zeros(n);
+                x[j] = sign * h;
+                self.set(&x);
+                self.sim.step()?;
+                *end = self.read();
+            }
+            phi.set_column(j, &((&ends[0] - &ends[1]) / (2.0 * h)));
+        }
+        self.sim = start;
+        if phi.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Domain(
+                "the step's linearisation gave a non-finite entry".into(),
+            ));
+        }
+        Ok(phi)
+    }
+
     /// The state derivative at reference + `x`.
     fn derivative(&mut self, x: &DVector<f64>) -> Result<DVector<f64>> {
         self.set(x);
@@ -372,7 +467,7 @@ impl<'a> Linear<'a> {
     }
 
     /// A mode from its eigenvalue and eigenvector: energy shares, name, shape.
-    fn mode(&self, l: Complex<f64>, v: &DVector<Complex<f64>>) -> Mode {
+    pub(super) fn mode(&self, l: Complex<f64>, v: &DVector<Complex<f64>>) -> Mode {
         let vehicle = self.sim.vehicle;
         // Kinetic energy of each degree of freedom from its displacement's rate λ·q (the
         // rates of the rotation coordinates, not the spinning wheelsets' angular velocity).

@@ -286,7 +286,11 @@ mod describing;
 mod eigen;
 mod linear;
 mod naming;
+mod step_map;
 
 pub use compare::{Comparison, Nonlinear, compare, nonlinear_views};
+pub use step_map::{
+    HIGH_FREQUENCY, StepCheck, StepLimit, check_step, guard, longest_step, step_limits,
+};
 
 use linear::Linear;
