@@ -82,7 +82,7 @@ fn the_explicit_step_is_held_shorter() {
 }
 
 /// Every integrator's own step lies inside the longest step the guard finds for it (release:
-/// four bisections), with the margins physics.md §6 quotes: 0.895 / 0.689 / 0.502 / 0.254 ms
+/// four bisections), with the margins physics.md §6 quotes: 0.895 / 0.689 / 0.531 / 0.254 ms
 /// against 5/6, 0.5, 0.2 and 0.2 ms.
 #[test]
 #[ignore]
@@ -95,7 +95,7 @@ fn every_integrators_own_step_is_held() {
         let quoted = match l.integrator {
             Integrator::LinearlyImplicitHertz => 0.895e-3,
             Integrator::LinearlyImplicit => 0.689e-3,
-            Integrator::SemiImplicit => 0.502e-3,
+            Integrator::SemiImplicit => 0.531e-3,
             Integrator::Heun => 0.254e-3,
         };
         assert!(l.holds(), "{l:?}");
@@ -123,4 +123,42 @@ fn the_guard_leaves_the_run_as_it_was() {
     }
     assert_eq!(looked.states(), plain.states());
     assert_eq!(looked.rails(), plain.rails());
+    assert_eq!(looked.wheels, plain.wheels);
+}
+
+/// The pads bound the default step (physics.md §2): the side frames' pitch on them grows as
+/// their stiffness's square root, so pads (0.895/0.833)² ≈ 1.15 times the file's reach the
+/// default step's limit. The fleet's stiffest pads (1.1 ×) pass the guard; 1.2 × (which
+/// chattered in every screening run) are refused before they run, and the guard's longest step
+/// for them falls by about √1.2 (release: two bisections).
+#[test]
+#[ignore]
+fn the_pads_bound_the_default_step() {
+    use railforce::vehicle::elements::Element;
+    let track = Track::load(&root().join("tracks/tangent.toml")).unwrap();
+    let with_pads = |factor: f64| {
+        let mut v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
+        for e in &mut v.elements {
+            if let Element::ShearPad(p) = e {
+                p.stiffness *= factor;
+            }
+        }
+        v
+    };
+    let hertz = Integrator::LinearlyImplicitHertz;
+    let default = 5.0 / 6.0 * 1e-3;
+    let fleet = with_pads(1.1);
+    let sim = Simulation::new(&fleet, &track, config(default, hertz)).unwrap();
+    assert!(!check_step(&sim).unwrap().bursts());
+    let stiff = with_pads(1.2);
+    let sim = Simulation::new(&stiff, &track, config(default, hertz)).unwrap();
+    let c = check_step(&sim).unwrap();
+    assert!(c.bursts() && c.mode.name.contains("sideframe"), "{c:?}");
+    let nominal = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
+    let at = |v: &Vehicle| {
+        let s = Simulation::new(v, &track, config(1e-3, hertz)).unwrap();
+        longest_step(&s).unwrap().unwrap()
+    };
+    let ratio = at(&nominal) / at(&stiff);
+    assert!((ratio / 1.2f64.sqrt() - 1.0).abs() < 0.05, "{ratio}");
 }

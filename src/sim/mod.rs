@@ -130,7 +130,7 @@ impl SimConfig {
     }
 }
 
-/// A running simulation (a copy runs on from the same state: the step guard linearises a run's step on one).
+/// A running simulation (a copy runs on from the same state: the step guard's).
 #[derive(Clone)]
 pub struct Simulation<'a> {
     vehicle: &'a Vehicle,

@@ -121,11 +121,12 @@ impl Simulation<'_> {
                     w.y_rel * 1e3
                 );
                 // Risen off the rail without moving onto the flange: a jump, not a climb. A
-                // step too coarse for the wheel–rail contact bursts this way (the loaded C80 at
-                // 1 ms on a class-5 tangent: 26.7 mm up, 0.7 mm across, within 0.04 s).
+                // step too coarse for a stiff coupling bursts this way (the loaded C80 stepped
+                // at 1 ms past the step guard, its side frames' pitch on the pads growing:
+                // 26.7 mm up, 0.7 mm across, within 0.04 s).
                 if w.lift > 0.5 * w.climb && w.y_rel.abs() < JUMP_SHIFT {
                     msg += &format!(
-                        ": it rose {:.1} mm off the rail without moving onto its flange, a jump; a step too coarse for the wheel–rail contact bursts this way ({:.4} ms here: try a finer --dt)",
+                        ": it rose {:.1} mm off the rail without moving onto its flange, a jump; a step too coarse for a stiff coupling (the wheel–rail contact, the pads) bursts this way ({:.4} ms here: try a finer --dt)",
                         w.lift * 1e3,
                         self.cfg.dt * 1e3
                     );

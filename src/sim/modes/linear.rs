@@ -88,44 +88,71 @@ impl<'a> Linear<'a> {
         sim.hauling_integral = x[last];
     }
 
-    /// The simulation's state as `x` against the reference: the inverse of [`Linear::set`].
-    fn read(&self) -> DVector<f64> {
+    /// Whether state `j` is a rate (a velocity), not a displacement.
+    fn is_rate(&self, j: usize) -> bool {
+        let base = 12 * self.bodies();
+        if j < base {
+            j % 12 >= 6
+        } else {
+            j + 1 < self.len() && (j - base) % 2 == 1
+        }
+    }
+
+    /// The difference step of state `j` in the numerical derivatives.
+    fn step_size(&self, j: usize) -> f64 {
+        let base = 12 * self.bodies();
+        match (j < base, j + 1 == self.len(), self.is_rate(j)) {
+            (_, true, _) => 1e-4,
+            (_, false, true) => 1e-5,
+            (true, false, false) => 1e-6,
+            (false, false, false) => 1e-7,
+        }
+    }
+
+    /// Per state, the weight that makes a rate comparable with a displacement over a step `dt`
+    /// (rates times `dt`).
+    pub(super) fn rate_weights(&self, dt: f64) -> DVector<f64> {
+        DVector::from_fn(self.len(), |j, _| if self.is_rate(j) { dt } else { 1.0 })
+    }
+
+    /// `a − b` of two copies of the run in the linear state's coordinates: the track axes of
+    /// each body's reference place, rotations as the rotation vector of `R_a·R_b⁻¹`.
+    pub(super) fn difference(&self, a: &Simulation, b: &Simulation) -> DVector<f64> {
         let n = self.len();
-        let sim = &self.sim;
         let mut x = DVector::zeros(n);
         for i in 0..self.bodies() {
             let at = self.axes[i].transpose();
-            let st = &sim.states[i];
+            let (p, q) = (&a.states[i], &b.states[i]);
             let blocks = [
-                at * (st.position - self.positions[i]),
-                at * (st.rotation * self.rotations[i].inverse()).scaled_axis(),
-                at * (st.velocity - self.velocities[i]),
-                at * (st.angular_velocity - self.omegas[i]),
+                at * (p.position - q.position),
+                at * (p.rotation * q.rotation.inverse()).scaled_axis(),
+                at * (p.velocity - q.velocity),
+                at * (p.angular_velocity - q.angular_velocity),
             ];
-            for (k, b) in blocks.iter().enumerate() {
+            for (k, v) in blocks.iter().enumerate() {
                 for j in 0..3 {
-                    x[12 * i + 3 * k + j] = b[j];
+                    x[12 * i + 3 * k + j] = v[j];
                 }
             }
         }
         let base = 12 * self.bodies();
         if self.compliant {
-            for (k, (r, r0)) in sim.rails.iter().zip(&self.rails).enumerate() {
+            for (k, (r, r0)) in a.rails.iter().zip(&b.rails).enumerate() {
                 x[base + 4 * k] = r.y - r0.y;
                 x[base + 4 * k + 1] = r.vy - r0.vy;
                 x[base + 4 * k + 2] = r.z - r0.z;
                 x[base + 4 * k + 3] = r.vz - r0.vz;
             }
         }
-        x[n - 1] = sim.hauling_integral;
+        x[n - 1] = a.hauling_integral - b.hauling_integral;
         x
     }
 
-    /// The state `x` against the reference after `steps` of the run's own steps from
-    /// reference + `x0` (the whole simulation copied first, and restored after).
-    pub(super) fn run_from(&mut self, x0: &DVector<f64>, steps: usize) -> Result<DVector<f64>> {
+    /// A copy of the run after `steps` of its own steps from reference + `x`; the reference
+    /// stays as it was.
+    pub(super) fn stepped(&mut self, x: &DVector<f64>, steps: usize) -> Result<Simulation<'a>> {
         let start = self.sim.clone();
-        self.set(x0);
+        self.set(x);
         let mut out = Ok(());
         for _ in 0..steps {
             out = self.sim.step();
@@ -133,48 +160,30 @@ impl<'a> Linear<'a> {
                 break;
             }
         }
-        let x = self.read();
-        self.sim = start;
-        out.map(|_| x)
+        let end = std::mem::replace(&mut self.sim, start);
+        out.map(|_| end)
     }
 
     /// The run's own step as a linear map `x_{n+1} = Φ·x_n` about the reference, by central
-    /// differences: each column is the difference of two steps from the reference state
-    /// stepped by ± a small amount (the reference's motion over the step cancels). Every step
-    /// starts from a copy of the whole simulation (friction sliders, rails on sleepers, the
-    /// train); the states outside `x` (the beams' modes, the sliders) start each step where
-    /// the reference has them.
+    /// differences: each column is the difference of two steps from the reference stepped by
+    /// ± a small amount, each read against the reference's own step (rotations included, so
+    /// the wheelsets' spin over the step mixes nothing). Every step starts from a copy of the
+    /// whole simulation (friction sliders, rails on sleepers, the train); the states outside
+    /// `x` (the beams' modes, the sliders) start each step where the reference has them.
     pub(super) fn step_matrix(&mut self) -> Result<DMatrix<f64>> {
         let n = self.len();
-        let base = 12 * self.bodies();
-        let start = self.sim.clone();
+        let reference = self.stepped(&DVector::zeros(n), 1)?;
         let mut phi = DMatrix::zeros(n, n);
         for j in 0..n {
-            let h = if j < base {
-                match j % 12 {
-                    0..=5 => 1e-6,
-                    _ => 1e-5,
-                }
-            } else if j < n - 1 {
-                match (j - base) % 4 {
-                    0 | 2 => 1e-7,
-                    _ => 1e-5,
-                }
-            } else {
-                1e-4
-            };
-            let mut ends = [DVector::zeros(0), DVector::zeros(0)];
-            for (end, sign) in ends.iter_mut().zip([1.0, -1.0]) {
-                self.sim = start.clone();
-                let mut x = DVector::zeros(n);
-                x[j] = sign * h;
-                self.set(&x);
-                self.sim.step()?;
-                *end = self.read();
-            }
-            phi.set_column(j, &((&ends[0] - &ends[1]) / (2.0 * h)));
+            let h = self.step_size(j);
+            let mut x = DVector::zeros(n);
+            x[j] = h;
+            let plus = self.stepped(&x, 1)?;
+            let minus = self.stepped(&(-x), 1)?;
+            let column = (self.difference(&plus, &reference) - self.difference(&minus, &reference))
+                / (2.0 * h);
+            phi.set_column(j, &column);
         }
-        self.sim = start;
         if phi.iter().any(|v| !v.is_finite()) {
             return Err(Error::Domain(
                 "the step's linearisation gave a non-finite entry".into(),
@@ -327,23 +336,10 @@ impl<'a> Linear<'a> {
             Ok((plus - minus) / (2.0 * h))
         };
         for j in 0..n {
-            let h = if j < base {
-                let (body, k) = (j / 12, j % 12);
-                if k == 1 && wheelsets.contains(&body) {
-                    continue; // below, once the roll and height columns are known
-                }
-                match k {
-                    0..=5 => 1e-6,
-                    _ => 1e-5,
-                }
-            } else if j < n - 1 {
-                match (j - base) % 4 {
-                    0 | 2 => 1e-7,
-                    _ => 1e-5,
-                }
-            } else {
-                1e-4
-            };
+            if j < base && j % 12 == 1 && wheelsets.contains(&(j / 12)) {
+                continue; // below, once the roll and height columns are known
+            }
+            let h = self.step_size(j);
             let mut x = DVector::zeros(n);
             x[j] = h;
             let c = column(self, &x, h)?;
