@@ -2,10 +2,11 @@
 //! follows the wagon, each wheel reads the rail under it at its own position, and each
 //! wheelset's linearly implicit solve takes the rail's step mobility under its wheels.
 //!
-//! In a wheelset's solve a rail point behaves as a body of mass `1/W` (W the track's step
-//! mobility at the wheel, [`crate::track::discrete::TrackDynamics::free`]) already moving by the
-//! beam's free change `Δv_free`: its rows are `(1/W + θΔt·C_c)·Δr = Δv_free/W + Δt·F − …`, the
-//! lumped rail's rows with the beam in place of the mass on its spring. The wheelsets solve
+//! In a wheelset's solve the rail's point under the wheel's load centre behaves as a body of
+//! mass matrix `W⁻¹` (W the track's 2×2 step mobility there, lateral and vertical, coupled by
+//! the rail's roll: [`crate::track::discrete::TrackDynamics::contact_free`]) already moving by
+//! the rails' free change `Δv_free`: its rows are `(W⁻¹ + θΔt·C_c)·Δr = W⁻¹·Δv_free + Δt·F − …`,
+//! the lumped rail's rows with the beams in place of the mass on its spring. The wheelsets solve
 //! one after another. The step starts with every wheel's impulse of the step before on the
 //! beams (a prediction); each wheelset takes its own back, solves, and leaves its new ones, so
 //! a wheel sees the new impulses of the wheelsets solved before it and the predicted ones of
@@ -83,9 +84,11 @@ impl Simulation<'_> {
         t.begin(self.cfg.dt);
         for (w, &b) in self.vehicle.contact.wheelsets.iter().enumerate() {
             for side in 0..2 {
-                let i = self.beam_impulses[2 * w + side];
-                t.impulse(side, 0, self.body_s[b], i.x);
-                t.impulse(side, 1, self.body_s[b], i.y);
+                let (i, lever) = (
+                    self.beam_impulses[2 * w + side],
+                    self.rail_coupling[2 * w + side].lever,
+                );
+                t.contact_impulse(side, self.body_s[b], lever, i);
             }
         }
     }
@@ -100,8 +103,15 @@ impl Simulation<'_> {
         t.recentre(centre);
         for (w, &b) in ws.iter().enumerate() {
             for side in 0..2 {
-                let [y, vy, z, vz] = t.rail(side, self.body_s[b]);
-                self.rails[2 * w + side] = RailState { y, vy, z, vz };
+                let [y, vy, z, vz, roll, roll_rate] = t.rail(side, self.body_s[b]);
+                self.rails[2 * w + side] = RailState {
+                    y,
+                    vy,
+                    z,
+                    vz,
+                    roll,
+                    roll_rate,
+                };
             }
         }
     }
@@ -125,22 +135,17 @@ impl Simulation<'_> {
             .expect("a wheelset solves on beams only when the track has them");
         let pair = 2 * k..2 * k + 2;
         let coupling = &self.rail_coupling[pair.clone()];
-        for side in 0..2 {
-            let i = self.beam_impulses[2 * k + side];
-            t.impulse(side, 0, s, -i.x);
-            t.impulse(side, 1, s, -i.y);
+        for (side, c) in coupling.iter().enumerate() {
+            t.contact_impulse(side, s, c.lever, -self.beam_impulses[2 * k + side]);
         }
-        let mut free = [(Vector2::zeros(), Vector2::zeros()); 2];
+        let mut free = [(Vector2::zeros(), Matrix2::zeros()); 2];
         let blocks = std::array::from_fn(|side| {
             let (c, f) = (&coupling[side], self.rail_force[2 * k + side]);
-            let (lat, ver) = (t.free(side, 0, s), t.free(side, 1, s));
-            let (dv_free, mass) = (
-                Vector2::new(lat.0, ver.0),
-                Vector2::new(1.0 / lat.1, 1.0 / ver.1),
-            );
+            let (dv_free, w) = t.contact_free(side, s, c.lever);
+            let mass = w.try_inverse().unwrap_or_else(Matrix2::zeros);
             free[side] = (dv_free, mass);
-            let l = Matrix2::from_diagonal(&mass) + c.damping * (THETA * dt);
-            let mut r = mass.component_mul(&dv_free) + Vector2::from(f) * dt;
+            let l = mass + c.damping * (THETA * dt);
+            let mut r = mass * dv_free + Vector2::from(f) * dt;
             if surface[side] != Vector2::zeros() {
                 r -= c.surface_on_rail * surface[side];
             }
@@ -148,9 +153,8 @@ impl Simulation<'_> {
         });
         let (du, dv) = with_rail_rows(body, d, du, dt, coupling, blocks);
         for (side, (dv, (dv_free, mass))) in dv.into_iter().zip(free).enumerate() {
-            let impulse = mass.component_mul(&(dv - dv_free));
-            t.impulse(side, 0, s, impulse.x);
-            t.impulse(side, 1, s, impulse.y);
+            let impulse = mass * (dv - dv_free);
+            t.contact_impulse(side, s, coupling[side].lever, impulse);
             self.beam_impulses[2 * k + side] = impulse;
         }
         du

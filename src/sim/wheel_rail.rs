@@ -7,7 +7,8 @@ use super::Simulation;
 use super::wheelset_solve::{RailCoupling, Shares};
 use crate::contact::{Creepage, Side, WheelOnRail, evaluate};
 use crate::error::Result;
-use nalgebra::{Matrix6, Vector3};
+use crate::track::discrete::Lever;
+use nalgebra::{Matrix6, Vector2, Vector3};
 
 /// What happened at one wheel in the last step.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -87,7 +88,7 @@ impl Simulation<'_> {
                 z_ds += rate;
             }
             let rail = self.rails[2 * w + k];
-            WheelOnRail {
+            let mut wr = WheelOnRail {
                 side,
                 y: rel.y - irr_y - rail.y,
                 height: rel.z - irr_z - rail.z,
@@ -98,9 +99,94 @@ impl Simulation<'_> {
                 surface_rate: [v.x * y_ds, v.x * z_ds],
                 speed: v.x,
                 mass: 0.5 * self.vehicle.bodies[b].mass,
+            };
+            if rail.roll != 0.0 || rail.roll_rate != 0.0 {
+                self.on_rolled_rail(&mut wr, k, &rail);
             }
+            wr
         });
         (wheels, rel.y)
+    }
+
+    /// The rail `k`'s torsion centre (0 left, 1 right) relative to its nominal place (the
+    /// gauge point's lateral place, the rail's top), track axes `(y, z)`, m; none on a track
+    /// whose rails do not roll.
+    fn torsion_centre(&self, k: usize) -> Option<Vector2<f64>> {
+        let p = self.beams.as_deref()?.support();
+        let y = self.vehicle.contact.geometry.half_gauge + p.torsion_centre_offset;
+        Some(Vector2::new(
+            if k == 0 { y } else { -y },
+            -p.torsion_centre_depth,
+        ))
+    }
+
+    /// The wheelset as the rail `k` sees it when the rail has rolled by θ about its torsion
+    /// centre C: its centre at `C + R(−θ)·(p − C)`, its roll less θ, its velocity relative to
+    /// the rail's material (`v − v_C − θ̇·x̂ × (p − C)`) and its angular velocity (less θ̇ about
+    /// x), both turned by `R(−θ)` into the rail's axes (each written as a change, so that no
+    /// roll changes nothing, bit for bit).
+    fn on_rolled_rail(&self, wr: &mut WheelOnRail, k: usize, rail: &super::RailState) {
+        let Some(c) = self.torsion_centre(k) else {
+            return;
+        };
+        let (sin, cos1) = (rail.roll.sin(), rail.roll.cos() - 1.0);
+        // R(−θ)·(a, b) − (a, b): the change of a vector (y, z) turned into the rail's axes.
+        let turn = |a: f64, b: f64| (a * cos1 + b * sin, b * cos1 - a * sin);
+        let (dy, dz) = (wr.y - c.x, wr.height - c.y);
+        let (ty, tz) = turn(dy, dz);
+        wr.y += ty;
+        wr.height += tz;
+        wr.roll -= rail.roll;
+        let (vy, vz) = (
+            wr.velocity[1] + rail.roll_rate * dz,
+            wr.velocity[2] - rail.roll_rate * dy,
+        );
+        let (ty, tz) = turn(vy, vz);
+        wr.velocity[1] = vy + ty;
+        wr.velocity[2] = vz + tz;
+        let w = &mut wr.angular_velocity;
+        w[0] -= rail.roll_rate;
+        let (ty, tz) = turn(w[1], w[2]);
+        w[1] += ty;
+        w[2] += tz;
+    }
+
+    /// A force or moment `(x, y, z)` in rail `k`'s axes turned back into the track's
+    /// (`R(θ)`, θ the rail's roll; unchanged where it has none).
+    fn to_track_axes(&self, k: usize, v: [f64; 3]) -> [f64; 3] {
+        let roll = self.rails[k].roll;
+        if roll == 0.0 {
+            return v;
+        }
+        let (sin, cos) = roll.sin_cos();
+        [v[0], v[1] * cos - v[2] * sin, v[1] * sin + v[2] * cos]
+    }
+
+    /// Where a wheel's load centre lies on its rolled rail, relative to the rail's torsion
+    /// centre: the patches' points (about the wheelset's centre, the rail's axes), weighed by
+    /// their normal loads, from the centre's place `wr` gives.
+    fn lever(
+        &self,
+        k: usize,
+        wr: &WheelOnRail,
+        patches: &[Option<crate::contact::PatchForce>; 2],
+    ) -> Lever {
+        let Some(c) = self.torsion_centre(k) else {
+            return Lever::default();
+        };
+        let (mut n, mut y, mut z) = (0.0, 0.0, 0.0);
+        for p in patches.iter().flatten() {
+            n += p.normal;
+            y += p.normal * p.point[1];
+            z += p.normal * p.point[2];
+        }
+        if n <= 0.0 {
+            return Lever::default();
+        }
+        Lever {
+            height: z / n + wr.height - c.y,
+            lateral: y / n + wr.y - c.x,
+        }
     }
 
     pub(super) fn contact(&mut self) -> Result<()> {
@@ -144,21 +230,25 @@ impl Simulation<'_> {
                     if alpha_dt > 0.0 {
                         coupling.set_surface(&surface, &f.axes);
                     }
+                    coupling.lever = self.lever(k, &wr, &out.patches);
                     self.rail_coupling[idx] = coupling;
                     damping += wheel;
                 }
-                let force = f.axes * Vector3::from(out.force);
-                self.wrenches[b].force += force;
-                self.wrenches[b].torque += f.axes * Vector3::from(out.moment);
-                self.rail_force[idx] = [-out.force[1], -out.force[2]];
+                let (force, moment) = (
+                    self.to_track_axes(idx, out.force),
+                    self.to_track_axes(idx, out.moment),
+                );
+                self.wrenches[b].force += f.axes * Vector3::from(force);
+                self.wrenches[b].torque += f.axes * Vector3::from(moment);
+                self.rail_force[idx] = [-force[1], -force[2]];
                 let lift = out.gap.max(0.0);
                 let main = out.main();
                 let rails = f.rails();
                 self.wheels[idx] = WheelResult {
                     s: self.body_s[b],
                     y_rel: wr.y,
-                    y: out.force[1],
-                    q: out.force[2],
+                    y: force[1],
+                    q: force[2],
                     normal: main.map_or(0.0, |p| p.normal),
                     creepage: main.map_or(Creepage::default(), |p| p.creepage),
                     angle: main.map_or(out.rigid_angle, |p| p.angle),

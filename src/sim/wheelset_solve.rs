@@ -33,7 +33,9 @@
 use nalgebra::{Matrix2, Matrix3, Matrix6, SMatrix, Vector2, Vector6};
 
 /// The rail under one wheel when the track is compliant: lateral and vertical displacement
-/// from its place (irregularity included) and their rates, track axes.
+/// from its place (irregularity excluded), its roll, and their rates, track axes. The lumped
+/// rail moves as a whole and does not roll; rails on sleepers give their torsion centre's
+/// motion and their roll about it.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct RailState {
     /// Lateral displacement, m (+ left).
@@ -44,6 +46,10 @@ pub struct RailState {
     pub z: f64,
     /// Vertical velocity, m/s.
     pub vz: f64,
+    /// Roll about the track's x, rad (+ moves the head to the right).
+    pub roll: f64,
+    /// Roll rate, rad/s.
+    pub roll_rate: f64,
 }
 
 /// The contact between one wheel and its rail mass, linearised for the linearly implicit step:
@@ -66,6 +72,9 @@ pub(super) struct RailCoupling {
     pub from_surface: nalgebra::SMatrix<f64, 6, 2>,
     /// The same on the rail (`Pᵀ·G_k·P`, track axes), with the opposite sign.
     pub surface_on_rail: nalgebra::Matrix2<f64>,
+    /// Where the contact's load centre lies on a rail on sleepers, relative to its torsion
+    /// centre (the rail's roll moves the point and the load twists the rail).
+    pub lever: crate::track::discrete::Lever,
 }
 
 impl RailCoupling {

@@ -326,7 +326,7 @@ impl TrackSpec {
             None => (None, None),
             Some(f) => match f.model(path)? {
                 super::support::RailModel::Lumped(l) => (Some(l), None),
-                super::support::RailModel::Discrete(d) => (None, Some(d)),
+                super::support::RailModel::Discrete(d) => (None, Some(*d)),
             },
         };
 

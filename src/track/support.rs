@@ -107,12 +107,12 @@ pub(super) struct RailSupportFile {
 }
 
 /// The rail support a track file chose.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(super) enum RailModel {
     /// Lumped rail masses under each wheel.
     Lumped(RailSupport),
     /// Rails on discrete sleepers.
-    Discrete(super::discrete::DiscreteSupport),
+    Discrete(Box<super::discrete::DiscreteSupport>),
 }
 
 impl RailSupportFile {
@@ -150,7 +150,7 @@ impl RailSupportFile {
                     Some(d) => d.support(path)?,
                     None => super::discrete::DiscreteFile::default().support(path)?,
                 };
-                Ok(RailModel::Discrete(p))
+                Ok(RailModel::Discrete(Box::new(p)))
             }
             other => Err(Error::config(
                 path,

@@ -1,10 +1,11 @@
 //! Rails as beams on discrete sleepers (`[rail_support] model = "discrete"`): the coupled
 //! vehicle–track model of Zhai's school, in a window of track that moves with the vehicle.
 //!
-//! Per rail, a vertical and a lateral Timoshenko beam (or Euler–Bernoulli, `rail_beam`), simply
-//! supported at the window's ends, in modal coordinates (`φ_k(x) = √(2/(m_k·L))·sin(kπx/L)`, two
+//! Per rail, a vertical and a lateral Timoshenko beam (or Euler–Bernoulli, `rail_beam`) and a
+//! torsional bar, simply supported at the window's ends, in modal coordinates (`φ_k(x) = √(2/(m_k·L))·sin(kπx/L)`, two
 //! modes per fastener and the pinned–pinned mode, so the rail bends between the sleepers).
-//! Each fastener is a rail pad (vertical and lateral spring and damper) to a rigid sleeper
+//! Each fastener is a rail pad (vertical and lateral spring and damper, the lateral at the
+//! rail's foot and the vertical spread across it, so both restrain the roll) to a rigid sleeper
 //! (vertical, lateral and roll); under each rail seat a ballast block on the subgrade, coupled
 //! to its neighbours in shear. With the fasteners evenly spaced the modes' values at the
 //! fasteners are a discrete sine transform (DST-I), and so are the sleepers' and the ballast's
@@ -15,8 +16,9 @@
 //! - **the Timoshenko beam's second branch** (the shear wave, cut on near 5.0 kHz for CHN60
 //!   vertically) and wavelengths under one bay: the shortest modes, half a bay long, stand at
 //!   2.8 kHz vertically and 1.9 kHz laterally;
-//! - **rail roll** (torsion): the lateral beam is the rail head on the lateral pads, so the
-//!   lateral compliance lacks the roll part the lumped model lumps in;
+//! - **warping**: the rails twist as St Venant bars (`GK`), their roll restrained by the pads;
+//!   the flange's warping stiffness and the section's distortion (the head bending about the
+//!   web) are left out;
 //! - **the pads' length**: a fastener is a point, so nothing damps the pinned–pinned mode but
 //!   the step (backward Euler on the rails' bending);
 //! - **the window's ends**: the rail is pinned there and the track beyond it is at rest
@@ -30,15 +32,20 @@
 //! tabled in Hindawi *Adv. Civ. Eng.* 2021, 8847633, Table 2, and *Shock Vib.* 2021, 5562152,
 //! Table 3, which gives the vertical shear coefficient 0.4; the lateral 0.54 is the UIC60
 //! figure of the rolland track model's rail table (an estimate for CHN60); the sleeper's roll
-//! inertia and rail-seat distance are estimates.
+//! inertia and rail-seat distance are estimates. The torsion (GK 1.9587 × 10⁵ N·m², polar
+//! moment 3.741 × 10⁻⁵ m⁴, torsion centre 94.53 mm below the rail's top, lateral pad 82 mm below
+//! it, vertical pad's half width 75 mm) is the CHN60 set of Zhai's vehicle–track coupled model
+//! as the VTCM code tables it; the torsion centre's lateral place, under the head's middle
+//! (36.5 mm from the gauge face: half CHN60's 73 mm head), is an estimate.
 
 mod checks;
 mod dynamics;
 mod file;
 mod receptance;
+mod wavenumber;
 
 pub use checks::{Check, checks};
-pub use dynamics::{Load, TrackDynamics};
+pub use dynamics::{Lever, Load, TrackDynamics};
 pub(super) use file::DiscreteFile;
 pub use receptance::{cut_on_frequencies, peaks, receptance};
 
@@ -74,6 +81,19 @@ pub struct DiscreteSupport {
     pub rail_rotary_vertical: f64,
     /// Rail rotary inertia per length for lateral bending (ρ·I_z), kg·m (Timoshenko only).
     pub rail_rotary_lateral: f64,
+    /// Rail torsional stiffness (St Venant, G·K), N·m².
+    pub rail_torsion_stiffness: f64,
+    /// Rail roll inertia per length about its torsion centre (ρ·I₀), kg·m.
+    pub rail_polar_inertia: f64,
+    /// Depth of the rail's torsion centre below its top, m.
+    pub torsion_centre_depth: f64,
+    /// Lateral distance of the torsion centre from the gauge point, toward the field side, m.
+    pub torsion_centre_offset: f64,
+    /// Depth of the lateral pad's line of action below the torsion centre, m.
+    pub pad_lateral_lever: f64,
+    /// Half the width over which the vertical pad carries the rail (its halves' lever about
+    /// the torsion centre), m.
+    pub pad_vertical_half_width: f64,
     /// Rail pad, vertical (per fastener).
     pub pad_vertical: KelvinVoigt,
     /// Rail pad and fastening, lateral (per fastener).
@@ -129,6 +149,14 @@ impl Default for DiscreteSupport {
             rail_shear_lateral: 0.54 * G * AREA,
             rail_rotary_vertical: RHO * 3.217e-5,
             rail_rotary_lateral: RHO * 5.24e-6,
+            // CHN60's torsion in Zhai's set (VTCM's rail table): GK and I₀ = I_y + I_z.
+            rail_torsion_stiffness: 1.9587e5,
+            rail_polar_inertia: RHO * 3.741e-5,
+            torsion_centre_depth: 0.09453,
+            // Estimate: under the middle of the 73 mm head.
+            torsion_centre_offset: 0.0365,
+            pad_lateral_lever: 0.082,
+            pad_vertical_half_width: 0.075,
             pad_vertical: KelvinVoigt {
                 stiffness: 6.5e7,
                 damping: 7.5e4,
@@ -240,6 +268,29 @@ impl DiscreteSupport {
         let b = self.beta();
         let a = b * x.abs();
         p * b / (2.0 * k) * (-a).exp() * (a.cos() + a.sin())
+    }
+
+    /// The rails all but held upright, the rest the same (the lumped rail's assumption): the
+    /// torsional stiffness ten thousand times the section's, so that a wheel's moment rolls
+    /// the rail a hundredth as far and over a length beyond the window.
+    pub fn without_roll(&self) -> Self {
+        DiscreteSupport {
+            rail_torsion_stiffness: 1e4 * self.rail_torsion_stiffness,
+            ..*self
+        }
+    }
+
+    /// The rail's roll at the `n`-th fastener from a static torque `t` (N·m) applied over one,
+    /// rad: a St Venant bar (`GK`) on a roll spring `k_f = k_v·b² + k_l·a²` at each fastener
+    /// (the rail's sway held), whose roll falls by `r = e^(−μ)` a bay, `cosh μ = 1 + k_f·s/2GK`,
+    /// from `θ₀ = t/(2·(GK/s)·sinh μ)` (the difference equation
+    /// `k_f·θ_n = (GK/s)·(θ_{n−1} − 2θ_n + θ_{n+1})`, derived here).
+    pub fn twist_at_fastener(&self, t: f64, n: usize) -> f64 {
+        let kf = self.pad_vertical.stiffness * self.pad_vertical_half_width.powi(2)
+            + self.pad_lateral.stiffness * self.pad_lateral_lever.powi(2);
+        let gk = self.rail_torsion_stiffness / self.spacing;
+        let mu = (1.0 + kf / (2.0 * gk)).acosh();
+        t / (2.0 * gk * mu.sinh()) * (-mu * n as f64).exp()
     }
 
     /// The critical speed of a load moving on the Winkler beam, `(4k·EI/m²)^¼`, m/s.
