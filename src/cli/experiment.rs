@@ -122,6 +122,11 @@ pub struct ExperimentArgs {
     /// results/. The project's is assets/docs/results.md.
     #[arg(long)]
     results: Option<PathBuf>,
+    /// With snapshot: replace in the existing --results file only the parts --out holds (their
+    /// sections, headline rows, wall times and commits), keeping the others as they were
+    /// measured; for one part run again after a change that touched its data alone.
+    #[arg(long)]
+    merge: bool,
     /// Replace the headline table this README quotes (between its results:headline markers)
     /// with the snapshot's.
     #[arg(long)]
@@ -156,7 +161,7 @@ pub fn run(args: ExperimentArgs) -> Result<()> {
             .results
             .clone()
             .unwrap_or_else(|| args.out.join(experiment::RESULTS_FILE));
-        let written = experiment::snapshot(&args.out, &dest, args.readme.as_deref())?;
+        let written = experiment::snapshot(&args.out, &dest, args.readme.as_deref(), args.merge)?;
         println!("results: {}", written.display());
         return Ok(());
     }

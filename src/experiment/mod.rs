@@ -21,6 +21,7 @@ mod protocols;
 mod robustness;
 mod sensors;
 mod snapshot;
+mod snapshot_merge;
 pub use snapshot::{
     HEADLINE_BEGIN, HEADLINE_END, headline_block, quoted_headline, requote, utc_date_time,
     write_snapshot,
@@ -173,9 +174,18 @@ pub struct ExperimentOptions {
 pub const RESULTS_FILE: &str = "results.md";
 
 /// Writes the snapshot of the finished run in `out` to `dest` and, with `readme`, replaces
-/// the headline table that README quotes; returns `dest`.
-pub fn snapshot(out: &Path, dest: &Path, readme: Option<&Path>) -> Result<PathBuf> {
-    let written = write_snapshot(out, dest)?;
+/// the headline table that README quotes; returns `dest`. With `merge`, the parts `out` holds
+/// replace theirs in the snapshot already at `dest` and the others stay as they were measured
+/// ([`snapshot_merge`]: one part run again after a change that touched its data alone).
+pub fn snapshot(out: &Path, dest: &Path, readme: Option<&Path>, merge: bool) -> Result<PathBuf> {
+    let written = if merge {
+        let old = crate::io::read_text(dest)?;
+        let merged = snapshot_merge::merge(&old, &snapshot::render(out, dest)?);
+        crate::io::write_atomic(dest, |w| w.write_all(merged.as_bytes()))?;
+        dest.to_path_buf()
+    } else {
+        write_snapshot(out, dest)?
+    };
     if let Some(readme) = readme {
         let snap = crate::io::read_text(&written)?;
         let text = crate::io::read_text(readme)?;
@@ -589,7 +599,7 @@ pub fn run(
     if parts.len() == Which::FOLDERS.len() {
         write_snapshot(&opts.out, &opts.out.join(RESULTS_FILE))?;
         if let Some(dest) = &opts.results {
-            snapshot(&opts.out, dest, opts.readme.as_deref())?;
+            snapshot(&opts.out, dest, opts.readme.as_deref(), false)?;
         }
     }
     Ok(opts.out.join("index.html"))

@@ -26,6 +26,14 @@ const SENSITIVITY: [&str; 2] = ["sensitivity/morris", "sensitivity/sobol"];
 /// that has not finished (no `meta.json` of the whole run) is written from the parts that
 /// have, and the snapshot says which are missing; a folder without any part is refused.
 pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
+    let md = render(out, dest)?;
+    crate::io::write_atomic(dest, |w| w.write_all(md.as_bytes()))?;
+    Ok(dest.to_path_buf())
+}
+
+/// The snapshot of the run in `out` as [`write_snapshot`] writes it to `dest` (the figures
+/// copied beside `dest` already).
+pub(super) fn render(out: &Path, dest: &Path) -> Result<String> {
     let meta_path = out.join("meta.json");
     let (meta, missing) = match read_json(&meta_path) {
         Some(m) if m["wall_seconds"].as_f64().is_some() => (m, Vec::new()),
@@ -185,8 +193,7 @@ pub fn write_snapshot(out: &Path, dest: &Path) -> Result<PathBuf> {
             md += &format!("![{cap}]({link})\n\n*{cap}*\n\n");
         }
     }
-    crate::io::write_atomic(dest, |w| w.write_all(md.as_bytes()))?;
-    Ok(dest.to_path_buf())
+    Ok(md)
 }
 
 /// The run's description from the parts that finished (each part's `meta.json` carries the
