@@ -67,7 +67,7 @@ pub(super) const WHEEL_SIGNALS: [(&str, &str, &str); 9] = [
     (
         "rail_y",
         "m",
-        "the rail's lateral deflection under the wheel, track axes (+ left; 0 on a rigid track)",
+        "the rail head's lateral deflection under the wheel, at its top, track axes (+ left; its roll included on sleepers; 0 on a rigid track)",
     ),
     (
         "rail_z",

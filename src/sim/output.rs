@@ -214,7 +214,7 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
             put(x);
         }
     }
-    for (w, rail) in sim.wheels.iter().zip(sim.rails()) {
+    for (w, (rail_y, rail_z)) in sim.wheels.iter().zip(sim.rail_heads()) {
         for x in [
             w.y,
             w.q,
@@ -223,8 +223,8 @@ fn signals(sim: &Simulation, paper: bool, body_vals: &mut Vec<[f64; 10]>, out: &
             w.creepage.x,
             w.creepage.y,
             w.creepage.spin,
-            rail.y,
-            rail.z,
+            rail_y,
+            rail_z,
         ] {
             put(x);
         }

@@ -76,6 +76,14 @@ pub(super) fn settled(
 }
 
 impl Simulation<'_> {
+    /// Each wheel's rail head under it, its top's lateral and vertical deflection (m, track
+    /// axes): the rail's own motion, and on sleepers its roll about the torsion centre below
+    /// (`y − d·θ`, d the centre's depth); none on a rigid track.
+    pub fn rail_heads(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let depth = (self.beams.as_deref()).map_or(0.0, |t| t.support().torsion_centre_depth);
+        (self.rails.iter()).map(move |r| (r.y - depth * r.roll, r.z))
+    }
+
     /// Starts the beams' step with every wheel's impulse of the step before on them.
     pub(super) fn begin_beams(&mut self) {
         let Some(t) = self.beams.as_deref_mut() else {
