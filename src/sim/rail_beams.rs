@@ -80,7 +80,7 @@ impl Simulation<'_> {
     /// axes): the rail's own motion, and on sleepers its roll about the torsion centre below
     /// (`y − d·θ`, d the centre's depth); none on a rigid track.
     pub fn rail_heads(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
-        let depth = (self.beams.as_deref()).map_or(0.0, |t| t.support().torsion_centre_depth);
+        let depth = self.rail_head_lever();
         (self.rails.iter()).map(move |r| (r.y - depth * r.roll, r.z))
     }
 

@@ -88,7 +88,7 @@ impl Simulation<'_> {
                 z_ds += rate;
             }
             let rail = self.rails[2 * w + k];
-            let mut wr = WheelOnRail {
+            WheelOnRail {
                 side,
                 y: rel.y - irr_y - rail.y,
                 height: rel.z - irr_z - rail.z,
@@ -99,13 +99,14 @@ impl Simulation<'_> {
                 surface_rate: [v.x * y_ds, v.x * z_ds],
                 speed: v.x,
                 mass: 0.5 * self.vehicle.bodies[b].mass,
-            };
-            if rail.roll != 0.0 || rail.roll_rate != 0.0 {
-                self.on_rolled_rail(&mut wr, k, &rail);
             }
-            wr
         });
         (wheels, rel.y)
+    }
+
+    /// The depth of the rails' torsion centre below their top, m (0 where they do not roll).
+    pub(super) fn rail_head_lever(&self) -> f64 {
+        (self.beams.as_deref()).map_or(0.0, |t| t.support().torsion_centre_depth)
     }
 
     /// The rail `k`'s torsion centre (0 left, 1 right) relative to its nominal place (the
@@ -198,8 +199,14 @@ impl Simulation<'_> {
             let f = &self.frames[b];
             let (inputs, y_centre) = self.wheels_on_rails(w);
             let mut damping = nalgebra::Matrix6::zeros();
-            for (k, wr) in inputs.into_iter().enumerate() {
+            for (k, on_track) in inputs.into_iter().enumerate() {
                 let idx = 2 * w + k;
+                // On a rolled rail the contact takes the wheelset in the rail's axes; the
+                // results below stay in the track's (the shift from the rail's head).
+                let (rail, mut wr) = (self.rails[idx], on_track);
+                if rail.roll != 0.0 || rail.roll_rate != 0.0 {
+                    self.on_rolled_rail(&mut wr, k, &rail);
+                }
                 let out = super::profile::timed!(
                     self.profile,
                     "  of which the patch solve (8 wheels)",
@@ -246,7 +253,7 @@ impl Simulation<'_> {
                 let rails = f.rails();
                 self.wheels[idx] = WheelResult {
                     s: self.body_s[b],
-                    y_rel: wr.y,
+                    y_rel: on_track.y + self.rail_head_lever() * rail.roll,
                     y: force[1],
                     q: force[2],
                     normal: main.map_or(0.0, |p| p.normal),
@@ -255,8 +262,8 @@ impl Simulation<'_> {
                     lift,
                     climb: main.map_or(out.rigid_radius, |p| p.radius) - cs.geometry.nominal_radius
                         + lift,
-                    yaw: wr.yaw,
-                    roll: wr.roll,
+                    yaw: on_track.yaw,
+                    roll: on_track.roll,
                     y_centre,
                     rail_slope: if k == 0 {
                         rails.left_y_ds
