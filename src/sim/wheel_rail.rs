@@ -253,7 +253,12 @@ impl Simulation<'_> {
                 let rails = f.rails();
                 self.wheels[idx] = WheelResult {
                     s: self.body_s[b],
-                    y_rel: on_track.y + self.rail_head_lever() * rail.roll,
+                    // From the head (−0.0 kept where the rail does not roll, bit for bit).
+                    y_rel: if rail.roll == 0.0 {
+                        on_track.y
+                    } else {
+                        on_track.y + self.rail_head_lever() * rail.roll
+                    },
                     y: force[1],
                     q: force[2],
                     normal: main.map_or(0.0, |p| p.normal),
