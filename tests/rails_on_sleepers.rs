@@ -130,7 +130,7 @@ fn runs_on_sleepers_repeat_bit_for_bit() {
     assert_eq!(a, b);
 }
 
-/// The discrete track's step: 0.2 ms unless a step is given; the integrators without the
+/// The discrete track's step: 0.1 ms unless a step is given; the integrators without the
 /// Hertz spring in the solve are refused with the reason.
 #[test]
 fn the_step_on_sleepers_and_what_is_refused() {
