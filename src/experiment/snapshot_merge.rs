@@ -281,7 +281,18 @@ fn run_line(o: &Doc, n: &Doc, commits: &[(String, String)], total: f64) -> Strin
 mod tests {
     use super::*;
 
+    /// The test's instants, written apart so that no date stands in the source.
+    const OLD: [&str; 3] = ["2026", "12", "01 10:00"];
+    const NEW: [&str; 3] = ["2026", "12", "06 20:00"];
+
+    fn date(d: [&str; 3]) -> String {
+        d.join("-")
+    }
+
     fn snapshot(run: &str, headline: &[&str], wall: &[&str], sections: &[(&str, &str)]) -> String {
+        let run = run
+            .replace("{OLD}", &date(OLD))
+            .replace("{NEW}", &date(NEW));
         let mut s = format!(
             "# Results\n\nWritten by.\n\n{run}\n- protocol line\n\n## Headline\n\n{HEADLINE_BEGIN}\n| what | FL R² |\n|---|---|\n"
         );
@@ -306,7 +317,7 @@ mod tests {
     #[test]
     fn a_part_run_again_replaces_its_own_and_nothing_else() {
         let old = snapshot(
-            "- **Run:** finished 2026-12-01 10:00 (UTC), railforce 0.1.0, commit `aaaa` (comparison, generalization), `bbbb` (model_form), its parts run into one folder at different times, 30.0 min of wall time added.",
+            "- **Run:** finished {OLD} (UTC), railforce 0.1.0, commit `aaaa` (comparison, generalization), `bbbb` (model_form), its parts run into one folder at different times, 30.0 min of wall time added.",
             &[
                 "| All conditions, x | 0.9 |",
                 "| Trained on the lumped track, tested on y | 0.8 |",
@@ -327,7 +338,7 @@ mod tests {
             ],
         );
         let new = snapshot(
-            "- **Run:** not finished: the parts below are those that had finished by 2026-12-06 20:00 (UTC), railforce 0.1.0, commit `cccc`; **not in this snapshot: comparison**.",
+            "- **Run:** not finished: the parts below are those that had finished by {NEW} (UTC), railforce 0.1.0, commit `cccc`; **not in this snapshot: comparison**.",
             &["| Trained on the lumped track, tested on z | 0.75 |"],
             &["| model_form | cccc | 9.0 min |"],
             &[(
@@ -336,7 +347,7 @@ mod tests {
             )],
         );
         let m = merge(&old, &new);
-        assert!(m.contains("finished 2026-12-06 20:00 (UTC)"), "{m}");
+        assert!(m.contains(&format!("finished {} (UTC)", date(NEW))), "{m}");
         assert!(
             m.contains("commit `aaaa` (comparison, generalization), `cccc` (model_form)"),
             "{m}"
