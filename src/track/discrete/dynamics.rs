@@ -95,14 +95,15 @@ pub struct TrackDynamics {
     p: DiscreteSupport,
     /// Along-track position of the window's start (a sleeper position), m.
     start: f64,
-    vertical: Direction<8, 2>,
-    lateral: Direction<9, 4>,
+    vertical: Direction<8, 2, 4>,
+    lateral: Direction<9, 4, 8>,
     /// The step the inverses were built for, s.
     dt: f64,
-    /// The sines at the last position asked for, and that position relative to the window's
-    /// start.
-    sines: Sines,
-    sines_at: f64,
+    /// The sines at the last [`SINES_KEPT`] positions asked for (a step asks at each
+    /// wheelset's), and those positions relative to the window's start; the next to replace.
+    sines: Vec<Sines>,
+    sines_x: Vec<f64>,
+    sines_next: usize,
     /// `sin(kπj/N)`, (N−1)², and `sin(kπi/2N)`, (2N−1)², for the window's shifts.
     table: Vec<f64>,
     table_half: Vec<f64>,
@@ -116,6 +117,9 @@ const VERTICAL_FIELDS: [(usize, usize); 2] = [(0, 6), (1, 7)];
 const LATERAL_FIELDS: [(usize, usize); 4] = [(0, 5), (1, 6), (3, 7), (4, 8)];
 /// The lateral fields' order: each rail's sway, then each rail's roll.
 const ROLL: usize = 2;
+
+/// How many positions' sines the track keeps: a wheelset's each, for four-axle wagons.
+const SINES_KEPT: usize = 4;
 
 /// The unit vector along degree of freedom `i`.
 fn unit<const D: usize>(i: usize) -> SVector<f64, D> {
@@ -217,12 +221,16 @@ impl TrackDynamics {
             vertical: Direction::new(vertical, VERTICAL_FIELDS, pv),
             lateral: Direction::new(lateral, LATERAL_FIELDS, pl),
             dt: 0.0,
-            sines: Sines {
-                low: vec![0.0; n],
-                pinned: 0.0,
-                high: vec![0.0; n],
-            },
-            sines_at: f64::NAN,
+            sines: vec![
+                Sines {
+                    low: vec![0.0; n],
+                    pinned: 0.0,
+                    high: vec![0.0; n],
+                };
+                SINES_KEPT
+            ],
+            sines_x: vec![f64::NAN; SINES_KEPT],
+            sines_next: 0,
             table: sine_table(p.bays),
             table_half: sine_table(2 * p.bays),
             p,
@@ -239,28 +247,32 @@ impl TrackDynamics {
         self.start
     }
 
-    /// `sin(kπx/L)` for every wavenumber k = 1 … 2N − 1 at `s` (held inside the window) into
-    /// `self.sines`, by the Chebyshev recurrence.
-    fn sines_at(&mut self, s: f64) {
+    /// `sin(kπx/L)` for every wavenumber k = 1 … 2N − 1 at `s` (held inside the window), by
+    /// the Chebyshev recurrence: the index of its entry in `self.sines`, computed unless kept.
+    fn sines_at(&mut self, s: f64) -> usize {
         let l = self.p.window();
         let x = (s - self.start).clamp(1e-6 * l, (1.0 - 1e-6) * l);
-        if x == self.sines_at {
-            return;
+        if let Some(i) = self.sines_x.iter().position(|&k| k == x) {
+            return i;
         }
-        self.sines_at = x;
+        let i = self.sines_next;
+        self.sines_next = (i + 1) % SINES_KEPT;
+        self.sines_x[i] = x;
+        let sines = &mut self.sines[i];
         let a = std::f64::consts::PI * x / l;
-        let n = self.sines.low.len();
+        let n = sines.low.len();
         let (c2, mut prev, mut cur) = (2.0 * a.cos(), 0.0, a.sin());
         for k in 0..2 * n + 1 {
             match k.cmp(&n) {
-                std::cmp::Ordering::Less => self.sines.low[k] = cur,
-                std::cmp::Ordering::Equal => self.sines.pinned = cur,
-                std::cmp::Ordering::Greater => self.sines.high[2 * n - k] = cur,
+                std::cmp::Ordering::Less => sines.low[k] = cur,
+                std::cmp::Ordering::Equal => sines.pinned = cur,
+                std::cmp::Ordering::Greater => sines.high[2 * n - k] = cur,
             }
             let next = c2 * cur - prev;
             prev = cur;
             cur = next;
         }
+        i
     }
 
     /// The lateral direction of rail `side`'s sway (`sway`) and roll (`roll`) combined.
@@ -282,10 +294,11 @@ impl TrackDynamics {
     /// and velocity and its roll and roll rate, `[y, vy, z, vz, θ, θ̇]` (m, m/s, rad, rad/s; y
     /// to the left, z up, θ about the track's x).
     pub fn rail(&mut self, side: usize, s: f64) -> [f64; 6] {
-        self.sines_at(s);
-        let (y, vy) = (self.lateral).point(&self.sines, &Self::lateral_along(side, 1.0, 0.0));
-        let (r, vr) = (self.lateral).point(&self.sines, &Self::lateral_along(side, 0.0, 1.0));
-        let (z, vz) = (self.vertical).point(&self.sines, &Self::vertical_along(side));
+        let at = self.sines_at(s);
+        let sines = &self.sines[at];
+        let (y, vy) = (self.lateral).point(sines, &Self::lateral_along(side, 1.0, 0.0));
+        let (r, vr) = (self.lateral).point(sines, &Self::lateral_along(side, 0.0, 1.0));
+        let (z, vz) = (self.vertical).point(sines, &Self::vertical_along(side));
         [y, vy, z, vz, r, vr]
     }
 
@@ -328,14 +341,15 @@ impl TrackDynamics {
         s: f64,
         lever: Lever,
     ) -> (Vector2<f64>, Matrix2<f64>) {
-        self.sines_at(s);
+        let at = self.sines_at(s);
+        let sines = &self.sines[at];
         let g = 2.0 / self.p.bays as f64;
         let c = [
             Self::lateral_along(side, 1.0, -lever.height),
             Self::lateral_along(side, 0.0, lever.lateral),
         ];
-        let (dv, mut w) = self.lateral.free(&self.sines, &c, g);
-        let (dz, wz) = (self.vertical).free(&self.sines, &[Self::vertical_along(side)], g);
+        let (dv, mut w) = self.lateral.free(sines, &c, g);
+        let (dz, wz) = (self.vertical).free(sines, &[Self::vertical_along(side)], g);
         w[(1, 1)] += wz[(0, 0)];
         (Vector2::new(dv[0], dv[1] + dz[0]), w)
     }
@@ -350,12 +364,13 @@ impl TrackDynamics {
     /// An impulse on rail `side` at `s` on its torsion centre's line: lateral, vertical (N·s)
     /// and twisting (N·m·s).
     pub fn impulse(&mut self, side: usize, s: f64, i: [f64; 3]) {
-        self.sines_at(s);
+        let at = self.sines_at(s);
+        let sines = &self.sines[at];
         let g = 2.0 / self.p.bays as f64;
         let c = Self::lateral_along(side, i[0], i[2]);
-        self.lateral.impulse(&self.sines, &c, g);
+        self.lateral.impulse(sines, &c, g);
         let c = Self::vertical_along(side);
-        self.vertical.impulse(&self.sines, &c, g * i[1]);
+        self.vertical.impulse(sines, &c, g * i[1]);
     }
 
     /// Ends the step: velocities take their change, displacements move with them.

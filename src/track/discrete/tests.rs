@@ -287,3 +287,44 @@ fn pinned_pinned_resonance_at_mid_span() {
     assert!(band(v, 962.5, 1001.5), "vertical {v} Hz");
     assert!(band(l, 445.2, 459.7), "lateral {l} Hz");
 }
+
+/// The step's impulses are kept apart and taken into the velocities at its end: what a wheel
+/// reads before the end (its point's velocity change, the mobility times the impulse) is what
+/// the rails move at after it, on the impulsed rail and on the other one through the
+/// sleepers.
+#[test]
+fn impulses_read_before_the_step_end_are_the_velocities_after_it() {
+    let p = DiscreteSupport::default();
+    let (dt, s) = (1e-4, 12.2);
+    let lever = Lever {
+        height: 0.07,
+        lateral: -0.01,
+    };
+    let mut t = TrackDynamics::new(p, 12.0);
+    t.begin(dt);
+    let (dv0, w) = t.contact_free(0, s, lever);
+    assert_eq!(dv0, nalgebra::Vector2::zeros());
+    let i = nalgebra::Vector2::new(30.0, -800.0);
+    t.contact_impulse(0, s, lever, i);
+    let (dv, w_after) = t.contact_free(0, s, lever);
+    assert_eq!(w, w_after, "the mobility does not depend on the impulses");
+    let expected = w * i;
+    assert!(
+        (dv - expected).norm() < 1e-12 * expected.norm(),
+        "{dv} against {expected}"
+    );
+    let (dv_other, _) = t.contact_free(1, s, lever);
+    assert!(
+        dv_other.norm() > 1e-9 * dv.norm(),
+        "the sleepers carry some to the other rail: {dv_other} against {dv}"
+    );
+    t.end(dt);
+    for (side, before) in [(0, dv), (1, dv_other)] {
+        let [_, vy, _, vz, _, vroll] = t.rail(side, s);
+        let after = nalgebra::Vector2::new(vy - lever.height * vroll, vz + lever.lateral * vroll);
+        assert!(
+            (after - before).norm() < 1e-9 * before.norm(),
+            "rail {side}: {after} after the step against {before} read before its end"
+        );
+    }
+}

@@ -7,6 +7,12 @@
 //! direction in the rail fields (`c`, one coefficient per field: the contact point's lateral
 //! motion is its rail's sway less the torsion centre's height times its roll), and an impulse
 //! enters along one.
+//!
+//! Within a step the impulses are kept as each wavenumber's generalised impulse on its rail
+//! degrees of freedom (two numbers per field and wavenumber) and taken through the inverse
+//! only where read: a point's velocity change reads the inverse's rail rows, the step's end
+//! its rail columns. The sweeps over the wavenumbers run four lanes wide where the CPU has AVX
+//! (detected at run time; no FMA, the same bits as the portable code).
 
 use nalgebra::{SMatrix, SVector};
 
@@ -112,13 +118,24 @@ pub(super) struct Sines {
 /// wavenumber's system and state, and the rails' pinned–pinned modes (wavenumber N, nodes at
 /// every fastener: no pad moves them, so they stand alone, one per rail field).
 #[derive(Debug, Clone)]
-pub(super) struct Direction<const D: usize, const R: usize> {
+pub(super) struct Direction<const D: usize, const R: usize, const S: usize> {
     pub systems: Vec<System<D>>,
     states: Vec<State<D>>,
     /// Each rail field's degrees of freedom: its wavenumber k's and its folded 2N − k's.
     fields: [(usize, usize); R],
     pub pinned: System<R>,
     pinned_state: State<R>,
+    /// The step's impulses so far, each wavenumber's generalised impulse on its rail degrees
+    /// of freedom (`[system][slot]`, slot `2j` field j's wavenumber k, `2j + 1` its folded
+    /// 2N − k), taken into the velocities at the step's end: an impulse then costs two
+    /// entries per field and wavenumber instead of two columns of the inverse.
+    imp: Vec<[f64; S]>,
+    /// Each system's inverse between its rail degrees of freedom, `[system][slot][slot]`:
+    /// what a point's velocity change and mobility read.
+    rail_inv: Vec<[[f64; S]; S]>,
+    /// Each system's inverse's columns of its rail degrees of freedom, `[system][slot][D]`:
+    /// what the step's end reads.
+    cols: Vec<[[f64; D]; S]>,
 }
 
 /// The nonzero coefficients of a direction in the rail fields.
@@ -129,8 +146,13 @@ fn nonzero<const R: usize>(c: &[f64; R]) -> impl Iterator<Item = (usize, f64)> +
         .map(|(j, &c)| (j, c))
 }
 
-impl<const D: usize, const R: usize> Direction<D, R> {
+impl<const D: usize, const R: usize, const S: usize> Direction<D, R, S> {
     pub fn new(systems: Vec<System<D>>, fields: [(usize, usize); R], pinned: System<R>) -> Self {
+        assert_eq!(
+            S,
+            2 * R,
+            "a direction's rail slots are its fields' k and 2N − k"
+        );
         let states = vec![State::default(); systems.len()];
         Direction {
             systems,
@@ -138,7 +160,16 @@ impl<const D: usize, const R: usize> Direction<D, R> {
             fields,
             pinned,
             pinned_state: State::default(),
+            imp: Vec::new(),
+            rail_inv: Vec::new(),
+            cols: Vec::new(),
         }
+    }
+
+    /// Slot `i`'s degree of freedom (slot `2j` field j's wavenumber k, `2j + 1` its folded).
+    fn slot_dof(&self, i: usize) -> usize {
+        let (lo, fo) = self.fields[i / 2];
+        if i.is_multiple_of(2) { lo } else { fo }
     }
 
     /// The rail's displacement and velocity along `c` at the point whose sines are `s`.
@@ -158,9 +189,38 @@ impl<const D: usize, const R: usize> Direction<D, R> {
         (x, v)
     }
 
+    /// Starts a step: every system's free velocity change from its state.
     pub fn begin(&mut self) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX (checked just above).
+            return unsafe { self.begin_avx() };
+        }
+        self.begin_lanes();
+    }
+
+    /// [`Direction::begin`] compiled for AVX: the same operations in the same order (no
+    /// FMA), so the same bits.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn begin_avx(&mut self) {
+        self.begin_lanes();
+    }
+
+    /// `Δv = −Δt·inv·((K + B)·x + (C + Δt·B)·v)`, column by column (lanes along the rows).
+    #[inline(always)]
+    fn begin_lanes(&mut self) {
         for (st, sys) in self.states.iter_mut().zip(&self.systems) {
-            st.dv = sys.from_x * st.x + sys.from_v * st.v;
+            let mut dv = [0.0; D];
+            let columns = (sys.from_x.as_slice().chunks_exact(D))
+                .zip(sys.from_v.as_slice().chunks_exact(D))
+                .zip(st.x.iter().zip(st.v.iter()));
+            for ((fx, fv), (x, v)) in columns {
+                for ((d, a), b) in dv.iter_mut().zip(fx).zip(fv) {
+                    *d += a * x + b * v;
+                }
+            }
+            st.dv = SVector::from(dv);
         }
         let (st, sys) = (&mut self.pinned_state, &self.pinned);
         st.dv = sys.from_x * st.x + sys.from_v * st.v;
@@ -174,25 +234,70 @@ impl<const D: usize, const R: usize> Direction<D, R> {
         c: &[[f64; R]; P],
         g: f64,
     ) -> (SVector<f64, P>, SMatrix<f64, P, P>) {
-        let (mut dv, mut w) = (SVector::<f64, P>::zeros(), SMatrix::<f64, P, P>::zeros());
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX (checked just above).
+            return unsafe { self.free_avx(s, c, g) };
+        }
+        self.free_lanes(s, c, g)
+    }
+
+    /// [`Direction::free`] compiled for AVX: the same operations in the same order (no FMA),
+    /// so the same bits.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn free_avx<const P: usize>(
+        &self,
+        s: &Sines,
+        c: &[[f64; R]; P],
+        g: f64,
+    ) -> (SVector<f64, P>, SMatrix<f64, P, P>) {
+        self.free_lanes(s, c, g)
+    }
+
+    #[inline(always)]
+    fn free_lanes<const P: usize>(
+        &self,
+        s: &Sines,
+        c: &[[f64; R]; P],
+        g: f64,
+    ) -> (SVector<f64, P>, SMatrix<f64, P, P>) {
+        debug_assert_eq!(self.imp.len(), self.states.len(), "factor() first");
+        // The fields any direction of `c` reads, each read once: its velocity change `u` and
+        // the mobility `m` between each pair of them.
+        let mut used = [false; R];
+        for (j, _) in c.iter().flat_map(nonzero) {
+            used[j] = true;
+        }
         let (pp, pi) = (&self.pinned_state, &self.pinned.inv);
+        let (mut u, mut m) = ([0.0; R], [[0.0; R]; R]);
+        for j in (0..R).filter(|&j| used[j]) {
+            u[j] = s.pinned * pp.dv[j];
+            for l in (j..R).filter(|&l| used[l]) {
+                m[j][l] = s.pinned * s.pinned * pi[(j, l)];
+            }
+        }
+        let systems = (self.states.iter()).zip(&self.imp).zip(&self.rail_inv);
+        for ((a, b), ((st, imp), ri)) in s.low.iter().zip(&s.high).zip(systems) {
+            for j in (0..R).filter(|&j| used[j]) {
+                let (lo, fo) = self.fields[j];
+                let (r_lo, r_fo) = (&ri[2 * j], &ri[2 * j + 1]);
+                let dv_lo = st.dv[lo] + dot_n(r_lo, imp);
+                let dv_fo = st.dv[fo] + dot_n(r_fo, imp);
+                u[j] += a * dv_lo + b * dv_fo;
+                for l in (j..R).filter(|&l| used[l]) {
+                    m[j][l] += a * (a * r_lo[2 * l] + b * r_lo[2 * l + 1])
+                        + b * (a * r_fo[2 * l] + b * r_fo[2 * l + 1]);
+                }
+            }
+        }
+        let (mut dv, mut w) = (SVector::<f64, P>::zeros(), SMatrix::<f64, P, P>::zeros());
         for p in 0..P {
             for (j, cj) in nonzero(&c[p]) {
-                let (lo, fo) = self.fields[j];
-                dv[p] += cj * s.pinned * pp.dv[j];
-                for ((a, b), st) in s.low.iter().zip(&s.high).zip(&self.states) {
-                    dv[p] += cj * (a * st.dv[lo] + b * st.dv[fo]);
-                }
+                dv[p] += cj * u[j];
                 for q in p..P {
                     for (l, cl) in nonzero(&c[q]) {
-                        let (lo2, fo2) = self.fields[l];
-                        let mut sum = s.pinned * s.pinned * pi[(j, l)];
-                        for ((a, b), sys) in s.low.iter().zip(&s.high).zip(&self.systems) {
-                            let i = &sys.inv;
-                            sum += a * (a * i[(lo, lo2)] + b * i[(lo, fo2)])
-                                + b * (a * i[(fo, lo2)] + b * i[(fo, fo2)]);
-                        }
-                        w[(p, q)] += g * cj * cl * sum;
+                        w[(p, q)] += g * cj * cl * m[j.min(l)][j.max(l)];
                     }
                 }
             }
@@ -205,25 +310,55 @@ impl<const D: usize, const R: usize> Direction<D, R> {
 
     /// An impulse along `c` at the point of `s`, `g` its `2/N` share times its size (N·s).
     pub fn impulse(&mut self, s: &Sines, c: &[f64; R], g: f64) {
+        debug_assert_eq!(self.imp.len(), self.states.len(), "factor() first");
         for (j, cj) in nonzero(c) {
-            let (lo, fo) = self.fields[j];
             self.pinned_state.dv += self.pinned.inv.column(j) * (g * cj * s.pinned);
-            for (((a, b), st), sys) in s
-                .low
-                .iter()
-                .zip(&s.high)
-                .zip(&mut self.states)
-                .zip(&self.systems)
-            {
-                st.dv += sys.inv.column(lo) * (g * cj * a) + sys.inv.column(fo) * (g * cj * b);
+            let gc = g * cj;
+            for ((a, b), imp) in s.low.iter().zip(&s.high).zip(&mut self.imp) {
+                imp[2 * j] += gc * a;
+                imp[2 * j + 1] += gc * b;
             }
         }
     }
 
+    /// Ends the step: the impulses into the velocity changes, then velocities and
+    /// displacements.
     pub fn end(&mut self, dt: f64) {
-        for st in &mut self.states {
-            st.v += st.dv;
-            st.x += st.v * dt;
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX (checked just above).
+            return unsafe { self.end_avx(dt) };
+        }
+        self.end_lanes(dt);
+    }
+
+    /// [`Direction::end`] compiled for AVX: the same operations in the same order (no FMA),
+    /// so the same bits.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn end_avx(&mut self, dt: f64) {
+        self.end_lanes(dt);
+    }
+
+    #[inline(always)]
+    fn end_lanes(&mut self, dt: f64) {
+        let systems = self.states.iter_mut().zip(&mut self.imp).zip(&self.cols);
+        for ((st, imp), cols) in systems {
+            let mut acc = [0.0; D];
+            for (i, col) in imp.iter().zip(cols) {
+                for (a, c) in acc.iter_mut().zip(col) {
+                    *a += c * i;
+                }
+            }
+            *imp = [0.0; S];
+            for (((x, v), dv), a) in (st.x.iter_mut().zip(st.v.iter_mut()))
+                .zip(st.dv.iter_mut())
+                .zip(acc)
+            {
+                *dv += a;
+                *v += *dv;
+                *x += *v * dt;
+            }
         }
         let pp = &mut self.pinned_state;
         pp.v += pp.dv;
@@ -234,6 +369,14 @@ impl<const D: usize, const R: usize> Direction<D, R> {
     pub fn factor(&mut self, dt: f64) {
         self.systems.iter_mut().for_each(|s| s.factor(dt));
         self.pinned.factor(dt);
+        let dofs: [usize; S] = std::array::from_fn(|i| self.slot_dof(i));
+        self.imp = vec![[0.0; S]; self.systems.len()];
+        self.rail_inv = (self.systems.iter())
+            .map(|sys| dofs.map(|r| dofs.map(|c| sys.inv[(r, c)])))
+            .collect();
+        self.cols = (self.systems.iter())
+            .map(|sys| dofs.map(|c| std::array::from_fn(|r| sys.inv[(r, c)])))
+            .collect();
     }
 
     /// Every field moved: the sleepers' and the ballast's by `at_fasteners` (N − 1
@@ -304,4 +447,61 @@ pub(super) fn moved(table: &[f64], n: usize, shift: i64, amps: Vec<f64>) -> Vec<
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn dot_n<const S: usize>(a: &[f64; S], b: &[f64; S]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX twins of the step's parts give the portable code's bits.
+    #[test]
+    fn avx_and_portable_steps_agree_bit_for_bit() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            let system = |k: f64| {
+                let mut s = System::new(SVector::<f64, 3>::new(50.0, 120.0, 40.0));
+                s.spring(SVector::<f64, 3>::new(1.0, -1.0, 0.0), 6.5e7 * k, 7.5e4);
+                s.spring(SVector::<f64, 3>::new(0.0, 1.0, 0.0), 1.4e8, 5.8e4);
+                s.spring(SVector::<f64, 3>::new(0.0, -1.0, 1.0), 6.5e7, 7.5e4);
+                s.bend = SVector::<f64, 3>::new(3e6 * k, 0.0, 9e6 * k);
+                s
+            };
+            let systems: Vec<System<3>> = (1..6).map(|k| system(k as f64)).collect();
+            let mut pinned = System::new(SVector::<f64, 1>::new(30.0));
+            pinned.bend[0] = 2e7;
+            let mut a = Direction::<3, 1, 2>::new(systems, [(0, 2)], pinned);
+            a.factor(1e-4);
+            for (k, st) in a.states.iter_mut().enumerate() {
+                st.x = SVector::from_fn(|r, _| 1e-4 * ((k * 3 + r) as f64).sin());
+                st.v = SVector::from_fn(|r, _| 1e-2 * ((k * 5 + r) as f64).cos());
+            }
+            let sines = Sines {
+                low: (1..6).map(|k| (0.3 * k as f64).sin()).collect(),
+                pinned: 0.7,
+                high: (1..6).map(|k| (0.2 * k as f64).cos()).collect(),
+            };
+            let mut b = a.clone();
+            a.begin_lanes();
+            // SAFETY: the CPU has AVX (checked above).
+            unsafe { b.begin_avx() };
+            for d in [&mut a, &mut b] {
+                d.impulse(&sines, &[1.0], 0.04 * 35.0);
+            }
+            let fa = a.free_lanes(&sines, &[[1.0]], 0.04);
+            // SAFETY: as above.
+            let fb = unsafe { b.free_avx(&sines, &[[1.0]], 0.04) };
+            assert_eq!(fa, fb);
+            a.end_lanes(1e-4);
+            // SAFETY: as above.
+            unsafe { b.end_avx(1e-4) };
+            for (sa, sb) in a.states.iter().zip(&b.states) {
+                assert_eq!((sa.x, sa.v), (sb.x, sb.v));
+            }
+            assert!(a.states.iter().any(|st| st.v != SVector::<f64, 3>::zeros()));
+        }
+    }
 }
