@@ -243,8 +243,13 @@ fn every_experiment_runs_end_to_end() {
             .starts_with("trained_on,tested_on,windows,fl_r2,fl_rmse_kn,fq_r2,fq_rmse_kn"),
         "{form}"
     );
-    // Two networks on three test sets: each track model, and short waves on the lumped one.
-    assert_eq!(form.lines().count(), 1 + 6, "{form}");
+    // Two networks from each of two training seeds on three test sets: each track model, and
+    // short waves on the lumped one; each pair's spread over the seeds.
+    assert_eq!(form.lines().count(), 1 + 12, "{form}");
+    assert!(form.contains("rails on sleepers, training seed"), "{form}");
+    let spread = std::fs::read_to_string(out.join("model_form/model_form_spread.csv")).unwrap();
+    assert_eq!(spread.lines().count(), 1 + 6, "{spread}");
+    assert!(spread.contains(" ± "), "{spread}");
     assert!(form.contains("lumped, cnossos_m roughness"), "{form}");
     assert!(
         form.contains("lumped rail masses,rails on sleepers"),
@@ -271,6 +276,8 @@ fn every_experiment_runs_end_to_end() {
     );
     // The lumped network is the generalisation part's, not trained again.
     assert!(!out.join("model_form/models/lumped").exists());
+    assert!(!out.join("model_form/models/lumped_seed2").exists());
+    assert!(out.join("model_form/models/on_sleepers_seed2").exists());
     assert!(html.contains("lumped track against rails on sleepers"));
     let data = meta["data_fnv1a"].clone();
 
