@@ -161,8 +161,9 @@ pub struct ExperimentOptions {
     /// The fleet of the mismatch experiment: a plan whose conditions (by name) give each of
     /// the plan's conditions its `[vary]` (the built-in `paper34_varied` for paper34).
     pub fleet: Option<PathBuf>,
-    /// Train the generalisation's CNN-BiLSTM from a second seed too, so its pooled R² is
-    /// stated with its spread over seeds (the full protocol; the demo leaves it out).
+    /// Train the generalisation's and the model-form part's CNN-BiLSTMs from a second seed
+    /// too, so their R² are stated with their spread over seeds (the full protocol; the demo
+    /// leaves it out).
     pub seed_spread: bool,
     /// Where to write the results snapshot besides `out/results.md`.
     pub results: Option<PathBuf>,
