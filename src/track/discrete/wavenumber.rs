@@ -76,7 +76,8 @@ impl<const D: usize> System<D> {
     }
 }
 
-/// One wavenumber's state: displacement, velocity and the step's velocity change so far.
+/// One wavenumber's state: displacement, velocity and the step's free velocity change (under
+/// its own springs and dampers; the step's impulses are kept apart until its end).
 #[derive(Debug, Clone, Copy)]
 struct State<const D: usize> {
     x: SVector<f64, D>,
