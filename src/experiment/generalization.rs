@@ -309,14 +309,7 @@ fn seed_spread(seed: u64, a: (&[Metrics], f64), b: (&[Metrics], f64)) -> Table {
     }
     let (x, y) = (a.0, b.0);
     let both = |f: &dyn Fn(&Metrics) -> f64, k: usize, digits: usize| {
-        let (u, v) = (f(&x[k]), f(&y[k]));
-        format!(
-            "{:.*} ± {:.*}",
-            digits,
-            0.5 * (u + v),
-            digits,
-            0.5 * (u - v).abs()
-        )
+        super::mean_half_range(f(&x[k]), f(&y[k]), digits)
     };
     let r2 = |m: &Metrics| m.r2;
     let kn = |m: &Metrics| m.rmse_kn;

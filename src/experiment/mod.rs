@@ -442,6 +442,17 @@ fn f4(v: f64) -> String {
     format!("{v:.4}")
 }
 
+/// Two runs' figures as `mean ± half range` to `digits` decimals (a spread over two seeds).
+fn mean_half_range(u: f64, v: f64, digits: usize) -> String {
+    format!(
+        "{:.*} ± {:.*}",
+        digits,
+        0.5 * (u + v),
+        digits,
+        0.5 * (u - v).abs()
+    )
+}
+
 fn read_log(dir: &Path) -> Vec<EpochLog> {
     crate::io::read_text(&dir.join("train_log.jsonl"))
         .map(|t| {

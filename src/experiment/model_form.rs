@@ -237,13 +237,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
     if offsets.len() == 2 {
         let half = scores.len() / 2;
         for ((trained, tested, a), (_, _, b)) in scores[..half].iter().zip(&scores[half..]) {
-            let both = |k: usize| {
-                format!(
-                    "{:.4} ± {:.4}",
-                    0.5 * (a[k] + b[k]),
-                    0.5 * (a[k] - b[k]).abs()
-                )
-            };
+            let both = |k: usize| super::mean_half_range(a[k], b[k], 4);
             spread.push(vec![trained.clone(), tested.clone(), both(0), both(1)]);
         }
     }
