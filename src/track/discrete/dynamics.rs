@@ -32,12 +32,16 @@
 //! Each system steps as the vehicle's wheelsets do, symplectic Euler with its springs and
 //! dampers shared into the step's end, its inverse built once per step length:
 //! `(M + Δt/2·C + Δt²/12·K + Δt²·B)·Δv = Δt·(F − K·x − B·(x + Δt·v) − C·v)`, `Δx = Δt·(v + Δv)`.
-//! `B`, the rails' bending and twisting and their own pads, is backward Euler: the bending
-//! modes up to 2.8 kHz (half a bay, vertical), which no step of the run follows, are damped
-//! rather than left ringing (with no numerical damping on them, α = ¼, Q's standard deviation
-//! was 34 % off at 0.5 ms on R 400 m at 100 km/h). `K`, the rest of the pads, the sleepers and
-//! the ballast, takes Fox and Goodwin's share (α = 1/12: a linear spring's frequency right to
-//! fourth order, stable below ω·Δt = 2.45, no numerical damping); the damping `C` takes θ = ½.
+//! `K`, the pads, sleepers and ballast and the rail waves the step follows, takes Fox and
+//! Goodwin's share (α = 1/12: a linear spring's frequency right to fourth order, stable below
+//! ω·Δt = 2.45, no numerical damping); the damping `C` takes θ = ½. `B` is backward Euler: each
+//! rail degree of freedom whose free frequency (its bending or twisting and its own pad
+//! stiffness on its mass) the step does not follow, `ω·Δt > 1` (at 0.1 ms the waves above
+//! 1.6 kHz, up to 2.8 kHz at half a bay), and the pinned–pinned modes, which no pad damps. Those
+//! are damped rather than left ringing (with no numerical damping on them, α = ¼, Q's standard
+//! deviation was 34 % off at 0.5 ms on R 400 m at 100 km/h). Backward Euler on the waves the
+//! step follows as well would add a damper `Δt·B` to the pads (6.5 kN·s/m beside their 75 at
+//! 0.1 ms) and leave FQ's 20–50 Hz band 6.5 % off at 0.1 ms (physics.md §3.3).
 //! The trapezoidal rule's displacement `Δt·(v + Δv/2)` is not the one the wheel's solve takes
 //! for the rail, and burst. The nodal fields are needed only when the window shifts by whole
 //! bays (every 0.6 m of travel): the sines' transform and its inverse, exact (the rails' at
@@ -173,7 +177,6 @@ impl TrackDynamics {
                 v.spring(unit(4 + side), sg.stiffness, sg.damping);
                 v.spring(unit(4 + side), shear * sh.stiffness, shear * sh.damping);
             }
-            v.rails_backward_euler(&VERTICAL_FIELDS);
             vertical.push(v);
             let ((ml, kl), (mh, kh)) = (mode(k, true), mode(2 * p.bays - k, true));
             let ((jl, tl), (jh, th)) = (twist(k), twist(2 * p.bays - k));
@@ -206,7 +209,6 @@ impl TrackDynamics {
             }
             let sl = p.sleeper_lateral;
             l.spring(unit(2), sl.stiffness, sl.damping);
-            l.rails_backward_euler(&LATERAL_FIELDS);
             lateral.push(l);
         }
         // The pinned–pinned modes: bending and twisting alone (no pad reaches them).
