@@ -182,7 +182,7 @@ fn the_step_on_sleepers_and_what_is_refused() {
 /// The step on sleepers against one four times finer, on R 400 m with its irregularities at
 /// 60 km/h: the label wheel's FQ within 3 % in each band. With the rails' bending and pads all
 /// backward Euler (the modes the step follows damped too) the 20–50 Hz band was 6.5 % off;
-/// with the followed modes at Fox and Goodwin's share it is 1.6 % (physics.md §3.3).
+/// with the followed modes at Fox and Goodwin's share it is 0.3 % (physics.md §3.3).
 #[test]
 #[ignore = "release: cargo test --release -- --ignored"]
 fn the_step_on_sleepers_holds_fq_by_band() {
