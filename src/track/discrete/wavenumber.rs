@@ -63,24 +63,24 @@ impl<const D: usize> System<D> {
     /// the rest of the track where `ω·Δt ≤ followed`, else backward Euler.
     fn factor(&mut self, dt: f64, followed: f64) {
         let mut k = self.k;
-        let mut b = SVector::<f64, D>::zeros();
+        let mut backward = SVector::<f64, D>::zeros();
         for d in (0..D).filter(|&d| self.bend[d] > 0.0) {
             let stiff = self.bend[d] + self.k[(d, d)];
             if stiff * dt * dt > followed * followed * self.m[d] {
-                b[d] = stiff;
+                backward[d] = stiff;
                 k[(d, d)] = 0.0;
             } else {
                 k[(d, d)] = stiff;
             }
         }
-        let bend = SMatrix::<f64, D, D>::from_diagonal(&b);
+        let b = SMatrix::<f64, D, D>::from_diagonal(&backward);
         let a = SMatrix::<f64, D, D>::from_diagonal(&self.m)
             + self.c * (0.5 * dt)
             + k * (dt * dt / 12.0)
-            + bend * (dt * dt);
+            + b * (dt * dt);
         self.inv = a.try_inverse().unwrap_or_else(SMatrix::zeros);
-        self.from_x = self.inv * (k + bend) * -dt;
-        self.from_v = self.inv * (self.c + bend * dt) * -dt;
+        self.from_x = self.inv * (k + b) * -dt;
+        self.from_v = self.inv * (self.c + b * dt) * -dt;
     }
 }
 
