@@ -3,7 +3,10 @@
 //! track cannot do is refused with a message.
 
 use railforce::sim::step_study::step_study;
-use railforce::sim::{Integrator, MAX_STEP_ON_BEAMS, SimConfig, Simulation, Stepping};
+use railforce::sim::{
+    Integrator, MAX_STEP_ON_BEAMS, MAX_TRAVEL_ON_BEAMS, SimConfig, Simulation, Stepping,
+    step_on_beams,
+};
 use railforce::track::{Track, TrackSpec};
 use railforce::vehicle::Vehicle;
 use std::path::PathBuf;
@@ -131,14 +134,24 @@ fn runs_on_sleepers_repeat_bit_for_bit() {
     assert_eq!(a, b);
 }
 
-/// The discrete track's step: 0.1 ms unless a step is given; the integrators without the
+/// The discrete track's step: 0.1 ms up to 60 km/h, faster a whole fraction of the 5 ms
+/// sample with at most 1.67 mm of travel, unless a step is given; the integrators without the
 /// Hertz spring in the solve are refused with the reason.
 #[test]
 fn the_step_on_sleepers_and_what_is_refused() {
     let spec = smooth_r400("discrete");
     let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
-    let step = |s: &Stepping, spec: &TrackSpec| s.step_on(spec, &v, 20.0).unwrap();
+    let step = |s: &Stepping, spec: &TrackSpec| s.step_on(spec, &v, 60.0 / 3.6).unwrap();
     assert_eq!(step(&Stepping::default(), &spec), MAX_STEP_ON_BEAMS);
+    for (kmh, per_sample) in [(40.0, 50.0), (60.0, 50.0), (80.0, 67.0), (100.0, 84.0)] {
+        let dt = Stepping::default().step_on(&spec, &v, kmh / 3.6).unwrap();
+        assert_eq!(dt, 5e-3 / per_sample, "{kmh} km/h");
+        assert_eq!(dt, step_on_beams(kmh / 3.6));
+        assert!(
+            dt * kmh / 3.6 <= MAX_TRAVEL_ON_BEAMS * (1.0 + 1e-9),
+            "{kmh} km/h"
+        );
+    }
     assert_eq!(step(&Stepping::chosen(None, Some(1e-4)), &spec), 1e-4);
     let lumped = smooth_r400("lumped");
     assert_eq!(step(&Stepping::default(), &lumped), Stepping::default().dt);
@@ -207,6 +220,36 @@ fn the_step_on_sleepers_holds_fq_by_band() {
     }
     // Something to hold: the 20–50 Hz band carries a few hundred newtons.
     assert!(study.reference_fq_bands[1] > 200.0, "{study:?}");
+}
+
+/// Faster, the step shortens with the speed: at 100 km/h on the same curve 0.1 ms was 1.02 %
+/// off in Y/Q and 6.3 % in FQ's 50–100 Hz band against 0.025 ms; the step of 1.67 mm of travel
+/// (0.0595 ms) holds every wheel's Y/Q rms within 1 % and each FQ band within 3 % of one four
+/// times finer (physics.md §3.3).
+#[test]
+#[ignore = "release: cargo test --release -- --ignored"]
+fn the_step_on_sleepers_follows_the_speed() {
+    let mut spec = TrackSpec::load(&root().join("tracks/curve_r400.toml")).unwrap();
+    spec.set_rail_model("discrete").unwrap();
+    let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
+    let track = Track::new(spec, None);
+    let speed = 100.0 / 3.6;
+    let dt = step_on_beams(speed);
+    let study = step_study(
+        &v,
+        &track,
+        speed,
+        15.0,
+        (dt / 4.0, Integrator::LinearlyImplicitHertz),
+        &[dt],
+        Integrator::LinearlyImplicitHertz,
+    )
+    .unwrap();
+    let d = study.trials[0].outcome.clone().unwrap();
+    assert!(d.yq_rms < 0.01, "Y/Q rms {:.2} % off", 100.0 * d.yq_rms);
+    for (e, band) in d.fq_bands.iter().zip(["0–20", "20–50", "50–100"]) {
+        assert!(*e < 0.03, "{band} Hz: {:.2} % off", 100.0 * e);
+    }
 }
 
 /// A track file's `[rail_support]` names its model; a discrete table with a lumped key, or an

@@ -273,9 +273,10 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Section> {
         title: "7. The simulator's form: lumped track against rails on sleepers (not in the paper)".into(),
         text: vec![
             format!(
-                "Every run of the plan simulated again on rails on discrete sleepers ({}: rails as beams on pads, sleepers, ballast and subgrade, the same conditions, seeds and irregularities, {} ms), and one CNN-BiLSTM on the paper's 21 trained on each track's data under the same split and noise: each tested on its own track and on the other. A network that keeps its R² across the change of track model carries what it learned from the vehicle, not from one track model's numbers.",
+                "Every run of the plan simulated again on rails on discrete sleepers ({}: rails as beams on pads, sleepers, ballast and subgrade, the same conditions, seeds and irregularities, {} ms, and above 60 km/h at most {:.2} mm of travel a step), and one CNN-BiLSTM on the paper's 21 trained on each track's data under the same split and noise: each tested on its own track and on the other. A network that keeps its R² across the change of track model carries what it learned from the vehicle, not from one track model's numbers.",
                 beams.name,
-                crate::sim::MAX_STEP_ON_BEAMS * 1e3
+                crate::sim::MAX_STEP_ON_BEAMS * 1e3,
+                crate::sim::MAX_TRAVEL_ON_BEAMS * 1e3
             ),
             format!(
                 "Both also tested on short waves no training run had: the test runs again on the lumped track with {ROUGHNESS} rail roughness below the irregularities ({}: CNOSSOS-EU's average network from where the irregularities stop down to 0.1 m, through the contact filter, 62.5 µs; physics.md §3.4).",

@@ -160,14 +160,33 @@ pub struct Stepping {
 }
 
 /// The longest step a run on rails on sleepers takes ([`crate::track::discrete`]) unless
-/// told otherwise. At 5/6 ms the rail under a flanging wheel (a bay's rail mass, 36 kg, against
-/// the flange's Hertz stiffness) is not followed: on R 400 m at 100 km/h the run chatters.
-/// With the rails rolling, 0.1 ms holds every wheel's Y/Q rms, Q's and FL's standard deviation
-/// within 1 % and FQ's bands within 3 % of the same model at 0.05 ms on R 400 m at 60 km/h
-/// (Y/Q 0.52 %, FQ 20–50 Hz 2.62 %), where 0.125 ms is 3.7 % off in that band and 0.2 ms 1.28 %
-/// in Y/Q and 7.2 % in the band (physics.md §3.3; `railforce bench step --rail-support discrete
-/// --reference 5e-5 --reference-integrator linearly-implicit-hertz`).
+/// told otherwise, at or below 60 km/h; faster, the step shortens with the speed
+/// ([`MAX_TRAVEL_ON_BEAMS`]). At 5/6 ms the rail under a flanging wheel (a bay's rail mass,
+/// 36 kg, against the flange's Hertz stiffness) is not followed: on R 400 m at 100 km/h the run
+/// chatters. Against the same model at 0.025 ms on R 400 m at 60 km/h, 0.1 ms holds every
+/// wheel's Y/Q rms within 0.84 %, Q's and FL's standard deviation within 0.14 and 0.06 % and
+/// FQ's 0–20 / 20–50 / 50–100 Hz bands within 0.03 / 0.28 / 1.64 %; 0.2 ms is 1.39 % off in
+/// Y/Q (physics.md §3.3; `railforce bench step --rail-support discrete --reference 2.5e-5
+/// --reference-integrator linearly-implicit-hertz`).
 pub const MAX_STEP_ON_BEAMS: f64 = 1e-4;
+
+/// The wagon's travel a step on rails on sleepers, m: 0.1 ms at 60 km/h. What a fixed step
+/// leaves (the coupling's error, first order in the step: physics.md §3.3) grows with the speed,
+/// as the excitation's frequencies and the sleepers' passing do: on R 400 m a fixed 0.1 ms is
+/// 1.25 % off in the trailing wheels' Y/Q at 80 km/h and 6.3 % in FQ's 50–100 Hz band at
+/// 100 km/h against 0.025 ms; at this travel a step (0.0746 and 0.0595 ms) Y/Q is 0.66 and
+/// 0.29 % off and the band 1.71 and 0.79 % (physics.md §3.3).
+pub const MAX_TRAVEL_ON_BEAMS: f64 = MAX_STEP_ON_BEAMS * 60.0 / 3.6;
+
+/// The step on rails on sleepers at `speed` (m/s): [`MAX_STEP_ON_BEAMS`] up to 60 km/h, above
+/// it [`MAX_TRAVEL_ON_BEAMS`] of travel a step at most, a whole fraction of the 5 ms sample.
+pub fn step_on_beams(speed: f64) -> f64 {
+    let wanted = MAX_TRAVEL_ON_BEAMS / speed.abs().max(1e-9);
+    if wanted >= MAX_STEP_ON_BEAMS * (1.0 - 1e-9) {
+        return MAX_STEP_ON_BEAMS;
+    }
+    SAMPLE_INTERVAL / (SAMPLE_INTERVAL / wanted - 1e-9).ceil()
+}
 
 impl PartialEq for Stepping {
     fn eq(&self, other: &Self) -> bool {
@@ -192,7 +211,7 @@ const SAMPLE_INTERVAL: f64 = 5e-3;
 
 impl Stepping {
     /// The longest step a run of `vehicle` on the track `spec` at `speed` (m/s) may take and
-    /// why: at most [`MAX_STEP_ON_BEAMS`] on rails on sleepers; over short waves (the track's
+    /// why: at most [`step_on_beams`] on rails on sleepers; over short waves (the track's
     /// roughness and welds, the wheels' flats and polygons) at most [`MAX_STEP_SHORT_WAVES`]
     /// and [`STEPS_PER_SHORTEST_WAVE`] steps per passing of the shortest wave, a whole fraction
     /// of the 5 ms sample. None on any other run.
@@ -202,9 +221,14 @@ impl Stepping {
         speed: f64,
     ) -> Option<(f64, String)> {
         let mut limit: Option<(f64, String)> = spec.discrete_rails.map(|_| {
+            let dt = step_on_beams(speed);
             (
-                MAX_STEP_ON_BEAMS,
-                "rails on sleepers are followed at 0.1 ms".to_string(),
+                dt,
+                format!(
+                    "rails on sleepers are followed at {:.4} ms ({:.2} mm of travel a step at most, 0.1 ms at most)",
+                    dt * 1e3,
+                    MAX_TRAVEL_ON_BEAMS * 1e3
+                ),
             )
         });
         let track = spec.short_waves.map(|w| w.shortest_wavelength());

@@ -33,7 +33,8 @@ mod wheel_rail;
 mod wheelset_solve;
 
 pub use integrator::{
-    Integrator, MAX_STEP_ON_BEAMS, MAX_STEP_SHORT_WAVES, STEPS_PER_SHORTEST_WAVE, Stepping,
+    Integrator, MAX_STEP_ON_BEAMS, MAX_STEP_SHORT_WAVES, MAX_TRAVEL_ON_BEAMS,
+    STEPS_PER_SHORTEST_WAVE, Stepping, step_on_beams,
 };
 pub use output::{Recorder, RunSummary};
 pub use request::RunRequest;
