@@ -88,7 +88,8 @@ enum What {
         /// Integrator (default: the default; `bench step` measures what each costs in accuracy).
         #[arg(long, value_parser = railforce::sim::Integrator::NAMES)]
         integrator: Option<String>,
-        /// Integration step, s (default: the integrator's own; 0.1 ms on rails on sleepers).
+        /// Integration step, s (default: the integrator's own; on rails on sleepers 0.1 ms, faster
+        /// than 60 km/h 1.67 mm of travel a step).
         #[arg(long)]
         dt: Option<f64>,
         /// The rails' support over the track file's (`rigid`, `lumped`, `discrete`, as
