@@ -2,7 +2,7 @@
 //! must (a smooth curve's quasi-static loads), runs repeat bit for bit, and what the discrete
 //! track cannot do is refused with a message.
 
-use railforce::sim::step_study::step_study;
+use railforce::sim::step_study::{StepDifference, StepStudy, step_study};
 use railforce::sim::{
     Integrator, MAX_STEP_ON_BEAMS, MAX_TRAVEL_ON_BEAMS, SimConfig, Simulation, Stepping,
     step_on_beams,
@@ -199,25 +199,8 @@ fn the_step_on_sleepers_and_what_is_refused() {
 #[test]
 #[ignore = "release: cargo test --release -- --ignored"]
 fn the_step_on_sleepers_holds_fq_by_band() {
-    let mut spec = TrackSpec::load(&root().join("tracks/curve_r400.toml")).unwrap();
-    spec.set_rail_model("discrete").unwrap();
-    let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
-    let track = Track::new(spec, None);
-    let reference = (MAX_STEP_ON_BEAMS / 4.0, Integrator::LinearlyImplicitHertz);
-    let study = step_study(
-        &v,
-        &track,
-        60.0 / 3.6,
-        30.0,
-        reference,
-        &[MAX_STEP_ON_BEAMS],
-        Integrator::LinearlyImplicitHertz,
-    )
-    .unwrap();
-    let d = study.trials[0].outcome.clone().unwrap();
-    for (e, band) in d.fq_bands.iter().zip(["0–20", "20–50", "50–100"]) {
-        assert!(*e < 0.03, "{band} Hz: {:.2} % off", 100.0 * e);
-    }
+    let (study, d) = step_on_r400_against_a_quarter(60.0, 30.0);
+    assert_bands_within_3_percent(&d.fq_bands);
     // Something to hold: the 20–50 Hz band carries a few hundred newtons.
     assert!(study.reference_fq_bands[1] > 200.0, "{study:?}");
 }
@@ -229,25 +212,36 @@ fn the_step_on_sleepers_holds_fq_by_band() {
 #[test]
 #[ignore = "release: cargo test --release -- --ignored"]
 fn the_step_on_sleepers_follows_the_speed() {
+    let (_, d) = step_on_r400_against_a_quarter(100.0, 15.0);
+    assert!(d.yq_rms < 0.01, "Y/Q rms {:.2} % off", 100.0 * d.yq_rms);
+    assert_bands_within_3_percent(&d.fq_bands);
+}
+
+/// The run on R 400 m with its irregularities on sleepers at `kmh` for `seconds`, at its
+/// default step against a quarter of it.
+fn step_on_r400_against_a_quarter(kmh: f64, seconds: f64) -> (StepStudy, StepDifference) {
     let mut spec = TrackSpec::load(&root().join("tracks/curve_r400.toml")).unwrap();
     spec.set_rail_model("discrete").unwrap();
     let v = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
     let track = Track::new(spec, None);
-    let speed = 100.0 / 3.6;
+    let speed = kmh / 3.6;
     let dt = step_on_beams(speed);
     let study = step_study(
         &v,
         &track,
         speed,
-        15.0,
+        seconds,
         (dt / 4.0, Integrator::LinearlyImplicitHertz),
         &[dt],
         Integrator::LinearlyImplicitHertz,
     )
     .unwrap();
     let d = study.trials[0].outcome.clone().unwrap();
-    assert!(d.yq_rms < 0.01, "Y/Q rms {:.2} % off", 100.0 * d.yq_rms);
-    for (e, band) in d.fq_bands.iter().zip(["0–20", "20–50", "50–100"]) {
+    (study, d)
+}
+
+fn assert_bands_within_3_percent(bands: &[f64; 3]) {
+    for (e, band) in bands.iter().zip(["0–20", "20–50", "50–100"]) {
         assert!(*e < 0.03, "{band} Hz: {:.2} % off", 100.0 * e);
     }
 }

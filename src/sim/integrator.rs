@@ -181,10 +181,12 @@ pub const MAX_TRAVEL_ON_BEAMS: f64 = MAX_STEP_ON_BEAMS * 60.0 / 3.6;
 /// The step on rails on sleepers at `speed` (m/s): [`MAX_STEP_ON_BEAMS`] up to 60 km/h, above
 /// it [`MAX_TRAVEL_ON_BEAMS`] of travel a step at most, a whole fraction of the 5 ms sample.
 pub fn step_on_beams(speed: f64) -> f64 {
-    let wanted = MAX_TRAVEL_ON_BEAMS / speed.abs().max(1e-9);
-    if wanted >= MAX_STEP_ON_BEAMS * (1.0 - 1e-9) {
-        return MAX_STEP_ON_BEAMS;
-    }
+    whole_fraction(MAX_STEP_ON_BEAMS.min(MAX_TRAVEL_ON_BEAMS / speed.abs().max(1e-9)))
+}
+
+/// The longest whole fraction of the 5 ms sample at most `wanted` (a step that a rounding
+/// error leaves a hair above a whole fraction is taken as that fraction).
+fn whole_fraction(wanted: f64) -> f64 {
     SAMPLE_INTERVAL / (SAMPLE_INTERVAL / wanted - 1e-9).ceil()
 }
 
@@ -239,7 +241,7 @@ impl Stepping {
                 .min(wheels.unwrap_or(f64::INFINITY));
             let f = speed.abs() / lambda;
             let wanted = MAX_STEP_SHORT_WAVES.min(1.0 / (STEPS_PER_SHORTEST_WAVE * f.max(1e-9)));
-            let dt = SAMPLE_INTERVAL / (SAMPLE_INTERVAL / wanted).ceil();
+            let dt = whole_fraction(wanted);
             if limit.as_ref().is_none_or(|(l, _)| dt < *l) {
                 limit = Some((
                     dt,
