@@ -104,7 +104,8 @@ pub fn affine_backward(
 ) {
     gemm(din, rows, dout, x, true, dy, false, dw, 1.0);
     if let Some(dx) = dx {
-        dx.clear();
+        // β = 0: the product overwrites `dx` and never reads it, so a buffer kept from the
+        // last step needs no zeroing.
         dx.resize(rows * din, 0.0);
         gemm(rows, dout, din, dy, false, w, true, dx, 0.0);
     }
@@ -228,21 +229,22 @@ pub fn tanh_into(src: &[f32], dst: &mut [f32]) {
 /// Leaky ReLU slope below zero (assets/docs/learning.md §3).
 pub const LEAKY_SLOPE: f32 = 0.01;
 
-/// In-place leaky ReLU.
+/// In-place leaky ReLU. Written as a select, not a conditional store, so that it runs as
+/// vector blends: the signs of activations are random and a branch on them mispredicts
+/// (the same values either way).
 pub fn leaky_relu(x: &mut [f32]) {
     for v in x {
-        if *v < 0.0 {
-            *v *= LEAKY_SLOPE;
-        }
+        let a = *v;
+        *v = if a < 0.0 { a * LEAKY_SLOPE } else { a };
     }
 }
 
-/// Backward of leaky ReLU given its output `y` (the sign is preserved): `dx = dy·f'(y)`.
+/// Backward of leaky ReLU given its output `y` (the sign is preserved): `dx = dy·f'(y)` (a
+/// select, as [`leaky_relu`]).
 pub fn leaky_relu_backward(y: &[f32], dy: &mut [f32]) {
     for (d, &v) in dy.iter_mut().zip(y) {
-        if v < 0.0 {
-            *d *= LEAKY_SLOPE;
-        }
+        let a = *d;
+        *d = if v < 0.0 { a * LEAKY_SLOPE } else { a };
     }
 }
 

@@ -9,6 +9,7 @@ mod gru;
 mod lstm;
 pub mod network;
 pub mod params;
+mod pool;
 
 pub use adam::Adam;
 pub use network::{Architecture, NetConfig, Network};

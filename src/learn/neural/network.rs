@@ -9,6 +9,7 @@ use super::dense::Dense;
 use super::gru::Gru;
 use super::lstm::BiLstm;
 use super::params::ParamSet;
+use super::pool::{max_pool_backward, max_pool_pairs};
 use crate::learn::linalg::{LEAKY_SLOPE, leaky_relu, leaky_relu_backward};
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -102,7 +103,6 @@ pub struct Network {
     r2: Vec<f32>,
     n2: Vec<f32>,
     pooled: Vec<f32>,
-    pick: Vec<bool>,
     feat: Vec<f32>,
     m0: Vec<f32>,
     f0: Vec<f32>,
@@ -111,6 +111,20 @@ pub struct Network {
     f1: Vec<f32>,
     h2: Vec<f32>,
     out: Vec<f32>,
+    /// The backward pass's gradients, kept between steps so that a step allocates nothing.
+    grads: BackwardBuffers,
+}
+
+/// Gradients of the backward pass with respect to each layer's input (named as the forward
+/// activations they belong to).
+#[derive(Default)]
+struct BackwardBuffers {
+    dh2: Vec<f32>,
+    dh1: Vec<f32>,
+    dfeat: Vec<f32>,
+    dpool: Vec<f32>,
+    dn2: Vec<f32>,
+    dn1: Vec<f32>,
 }
 
 impl Network {
@@ -168,7 +182,6 @@ impl Network {
             r2: Vec::new(),
             n2: Vec::new(),
             pooled: Vec::new(),
-            pick: Vec::new(),
             feat: Vec::new(),
             m0: Vec::new(),
             f0: Vec::new(),
@@ -177,6 +190,7 @@ impl Network {
             f1: Vec::new(),
             h2: Vec::new(),
             out: Vec::new(),
+            grads: BackwardBuffers::default(),
         }
     }
 
@@ -303,26 +317,7 @@ impl Network {
             self.n2.clone_from(&self.r2);
             stem.bn2.forward(p, &mut self.n2, train);
             // MaxPool1d(2, stride 1) over time.
-            let w = STEM_WIDTH;
-            self.pooled.resize(batch * (t - 1) * w, 0.0);
-            self.pick
-                .resize(if train { self.pooled.len() } else { 0 }, false);
-            for b in 0..batch {
-                let src = &self.n2[b * t * w..(b + 1) * t * w];
-                let dst = &mut self.pooled[b * (t - 1) * w..(b + 1) * (t - 1) * w];
-                for (s, out) in dst.chunks_exact_mut(w).enumerate() {
-                    let (u, v) = (&src[s * w..(s + 1) * w], &src[(s + 1) * w..(s + 2) * w]);
-                    for ((o, &a), &c) in out.iter_mut().zip(u).zip(v) {
-                        *o = a.max(c);
-                    }
-                }
-                if train {
-                    let pick = &mut self.pick[b * (t - 1) * w..(b + 1) * (t - 1) * w];
-                    for (i, p) in pick.iter_mut().enumerate() {
-                        *p = src[i + w] > src[i];
-                    }
-                }
-            }
+            max_pool_pairs(&self.n2, batch, t, STEM_WIDTH, &mut self.pooled);
         }
         let seq: &[f32] = if self.stem.is_some() { &self.pooled } else { x };
         let steps = if self.stem.is_some() { t - 1 } else { t };
@@ -363,58 +358,45 @@ impl Network {
         let batch = self.batch;
         let (t, c) = (self.config.window, self.config.channels);
         let p = &mut self.params;
-        let mut dh2 = Vec::new();
-        self.d3.backward(p, &self.h2, dout, batch, Some(&mut dh2));
-        leaky_relu_backward(&self.h2, &mut dh2);
-        let mut dh1 = Vec::new();
-        self.d2.backward(p, &self.f1, &dh2, batch, Some(&mut dh1));
-        mul_in_place(&mut dh1, &self.m1);
-        leaky_relu_backward(&self.h1, &mut dh1);
-        let mut dfeat = Vec::new();
-        self.d1.backward(p, &self.f0, &dh1, batch, Some(&mut dfeat));
-        mul_in_place(&mut dfeat, &self.m0);
+        let g = &mut self.grads;
+        self.d3.backward(p, &self.h2, dout, batch, Some(&mut g.dh2));
+        leaky_relu_backward(&self.h2, &mut g.dh2);
+        self.d2
+            .backward(p, &self.f1, &g.dh2, batch, Some(&mut g.dh1));
+        mul_in_place(&mut g.dh1, &self.m1);
+        leaky_relu_backward(&self.h1, &mut g.dh1);
+        self.d1
+            .backward(p, &self.f0, &g.dh1, batch, Some(&mut g.dfeat));
+        mul_in_place(&mut g.dfeat, &self.m0);
         let Some(stem) = &mut self.stem else {
             match &mut self.rnn {
-                Recurrent::Lstm(l) => l.backward(p, x, &dfeat, None),
-                Recurrent::Gru(g) => g.backward(p, x, &dfeat, None),
+                Recurrent::Lstm(l) => l.backward(p, x, &g.dfeat, None),
+                Recurrent::Gru(gru) => gru.backward(p, x, &g.dfeat, None),
                 Recurrent::None => unreachable!("every network without a stem is recurrent"),
             }
             return;
         };
         let dpool = match &mut self.rnn {
             Recurrent::Lstm(l) => {
-                let mut d = Vec::new();
-                l.backward(p, &self.pooled, &dfeat, Some(&mut d));
-                d
+                l.backward(p, &self.pooled, &g.dfeat, Some(&mut g.dpool));
+                &g.dpool
             }
-            Recurrent::Gru(g) => {
-                let mut d = Vec::new();
-                g.backward(p, &self.pooled, &dfeat, Some(&mut d));
-                d
+            Recurrent::Gru(gru) => {
+                gru.backward(p, &self.pooled, &g.dfeat, Some(&mut g.dpool));
+                &g.dpool
             }
-            Recurrent::None => dfeat,
+            Recurrent::None => &g.dfeat,
         };
         let w = STEM_WIDTH;
-        let mut dn2 = vec![0.0f32; batch * t * w];
-        let mut i = 0;
-        for b in 0..batch {
-            for s in 0..t - 1 {
-                let r0 = (b * t + s) * w;
-                for k in 0..w {
-                    let at = if self.pick[i] { r0 + w + k } else { r0 + k };
-                    dn2[at] += dpool[i];
-                    i += 1;
-                }
-            }
-        }
+        max_pool_backward(&self.n2, dpool, batch, t, w, &mut g.dn2);
         let rows = batch * t;
-        stem.bn2.backward(p, &mut dn2);
-        leaky_relu_backward(&self.r2, &mut dn2);
-        let mut dn1 = Vec::new();
-        stem.c2.backward(p, &self.n1, &dn2, rows, Some(&mut dn1));
-        stem.bn1.backward(p, &mut dn1);
-        leaky_relu_backward(&self.r1, &mut dn1);
-        stem.c1.backward(p, x, &dn1, rows, None);
+        stem.bn2.backward(p, &mut g.dn2);
+        leaky_relu_backward(&self.r2, &mut g.dn2);
+        stem.c2
+            .backward(p, &self.n1, &g.dn2, rows, Some(&mut g.dn1));
+        stem.bn1.backward(p, &mut g.dn1);
+        leaky_relu_backward(&self.r1, &mut g.dn1);
+        stem.c1.backward(p, x, &g.dn1, rows, None);
         debug_assert_eq!(x.len(), rows * c);
     }
 
@@ -492,17 +474,6 @@ fn leaky_affine(x: &mut [f32], scale: &[f32], shift: &[f32]) {
         for ((v, a), b) in row.iter_mut().zip(scale).zip(shift) {
             let y = if *v < 0.0 { *v * LEAKY_SLOPE } else { *v };
             *v = y * a + b;
-        }
-    }
-}
-
-/// MaxPool1d(2, stride 1) over time of `x[B, T, W]` into `y[B, T−1, W]`.
-fn max_pool_pairs(x: &[f32], batch: usize, t: usize, w: usize, y: &mut Vec<f32>) {
-    y.clear();
-    for b in 0..batch {
-        let src = &x[b * t * w..(b + 1) * t * w];
-        for (u, v) in src.chunks_exact(w).zip(src[w..].chunks_exact(w)) {
-            y.extend(u.iter().zip(v).map(|(a, c)| a.max(*c)));
         }
     }
 }
