@@ -180,7 +180,8 @@ enum Command {
     /// the end. A run of all seven writes results.md, the snapshot of what it measured (date,
     /// commit, protocol, the wall time of each part, every table); `experiment snapshot`
     /// rewrites it from a finished folder. The full protocol on the paper's 34 conditions
-    /// takes about three and a half hours on two cores (results.md), most of it training.
+    /// takes hours on two cores, most of it training (results.md records each part's wall
+    /// time).
     #[command(
         after_help = "Examples:\n  railforce experiment comparison --plan demo --out experiments --epochs 2 --windows-per-epoch 2000"
     )]
