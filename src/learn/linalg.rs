@@ -229,13 +229,17 @@ pub fn tanh_into(src: &[f32], dst: &mut [f32]) {
 /// Leaky ReLU slope below zero (assets/docs/learning.md §3).
 pub const LEAKY_SLOPE: f32 = 0.01;
 
-/// In-place leaky ReLU. Written as a select, not a conditional store, so that it runs as
-/// vector blends: the signs of activations are random and a branch on them mispredicts
-/// (the same values either way).
+/// Leaky ReLU of one value, as a select (not a conditional store) so that loops over it run
+/// as vector blends: the signs of activations are random and a branch on them mispredicts.
+#[inline(always)]
+pub fn leaky(v: f32) -> f32 {
+    if v < 0.0 { v * LEAKY_SLOPE } else { v }
+}
+
+/// In-place leaky ReLU ([`leaky`] on each value).
 pub fn leaky_relu(x: &mut [f32]) {
     for v in x {
-        let a = *v;
-        *v = if a < 0.0 { a * LEAKY_SLOPE } else { a };
+        *v = leaky(*v);
     }
 }
 

@@ -10,7 +10,7 @@ use super::gru::Gru;
 use super::lstm::BiLstm;
 use super::params::ParamSet;
 use super::pool::{max_pool_backward, max_pool_pairs};
-use crate::learn::linalg::{LEAKY_SLOPE, leaky_relu, leaky_relu_backward};
+use crate::learn::linalg::{leaky, leaky_relu, leaky_relu_backward};
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
@@ -387,8 +387,7 @@ impl Network {
             }
             Recurrent::None => &g.dfeat,
         };
-        let w = STEM_WIDTH;
-        max_pool_backward(&self.n2, dpool, batch, t, w, &mut g.dn2);
+        max_pool_backward(&self.n2, dpool, batch, t, STEM_WIDTH, &mut g.dn2);
         let rows = batch * t;
         stem.bn2.backward(p, &mut g.dn2);
         leaky_relu_backward(&self.r2, &mut g.dn2);
@@ -472,8 +471,7 @@ const EVAL_CHUNK: usize = 64;
 fn leaky_affine(x: &mut [f32], scale: &[f32], shift: &[f32]) {
     for row in x.chunks_exact_mut(scale.len()) {
         for ((v, a), b) in row.iter_mut().zip(scale).zip(shift) {
-            let y = if *v < 0.0 { *v * LEAKY_SLOPE } else { *v };
-            *v = y * a + b;
+            *v = leaky(*v) * a + b;
         }
     }
 }
