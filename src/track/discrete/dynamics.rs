@@ -48,7 +48,8 @@
 //! every half bay).
 
 use super::DiscreteSupport;
-use super::wavenumber::{Direction, Sines, System, moved, sine_table};
+use super::system::System;
+use super::wavenumber::{Direction, Sines, moved, sine_table};
 use nalgebra::{Matrix2, SVector, Vector2};
 
 /// Left and right rail (track y positive to the left): the sign of a rail seat's lever
@@ -225,9 +226,9 @@ impl TrackDynamics {
             dt: 0.0,
             sines: vec![
                 Sines {
-                    low: vec![0.0; n],
+                    low: vec![0.0; Sines::padded(n)],
                     pinned: 0.0,
-                    high: vec![0.0; n],
+                    high: vec![0.0; Sines::padded(n)],
                 };
                 SINES_KEPT
             ],
@@ -262,7 +263,7 @@ impl TrackDynamics {
         self.sines_x[i] = x;
         let sines = &mut self.sines[i];
         let a = std::f64::consts::PI * x / l;
-        let n = sines.low.len();
+        let n = self.p.bays - 1;
         let (c2, mut prev, mut cur) = (2.0 * a.cos(), 0.0, a.sin());
         for k in 0..2 * n + 1 {
             match k.cmp(&n) {

@@ -42,6 +42,7 @@ mod checks;
 mod dynamics;
 mod file;
 mod receptance;
+mod system;
 mod wavenumber;
 
 pub use checks::{Check, checks};
