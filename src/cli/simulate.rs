@@ -29,8 +29,9 @@ pub struct SimulateArgs {
     /// The rails' support, over the track file's `[rail_support]`: `rigid`; `lumped` (a rail
     /// mass on springs under each wheel: the file's); `discrete` (rails as beams on sleepers,
     /// ballast and subgrade, Zhai's parameters unless the file gives its own; a step costs
-    /// about 3.7 times the lumped track's and runs at 0.1 ms, faster than 60 km/h at 1.67 mm of
-    /// travel a step: some 30 times slower; the default integrator only).
+    /// about 2.2 times the lumped track's at the same step and runs at 0.1 ms, faster than
+    /// 60 km/h at 1.67 mm of travel a step: some 17 times slower than the lumped track at its
+    /// own step; the default integrator only).
     #[arg(long, value_parser = railforce::track::RAIL_SUPPORT_MODELS)]
     rail_support: Option<String>,
     /// Rail roughness below the irregularities, over the track file's `[roughness]`:
