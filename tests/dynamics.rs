@@ -305,6 +305,23 @@ fn accelerometers_read_specific_force_or_kinematic_acceleration() {
             assert!(d[2] > 0.999 * railforce::GRAVITY, "{} reads g up", b.name);
         }
     }
+    // The run's peak |Y/Q| of each wheel is its recorded Y over Q wherever the wheel carries
+    // a tenth of its static load, read by the channels' names (every wheel, not the first
+    // wheel's columns and a fixed stride), and small on a tangent.
+    let static_load = c80().mass() * railforce::GRAVITY / 8.0;
+    for (k, &peak) in sf.summary.peak_y_over_q.iter().enumerate() {
+        let w = railforce::sim::wheel_name(k).to_ascii_lowercase();
+        let (y, q) = (col(&format!("w{w}_force_y")), col(&format!("w{w}_force_z")));
+        let expected = (sf.rows.iter())
+            .filter(|r| r[q] > 0.1 * static_load)
+            .map(|r| (r[y] / r[q]).abs())
+            .fold(0.0, f64::max);
+        assert_eq!(peak, expected, "wheel {w}");
+        assert!(
+            expected > 0.0 && expected < 0.3,
+            "wheel {w}: Y/Q {expected}"
+        );
+    }
 }
 
 /// Quasi-static curving within 3 % of Newton's law (release: `cargo test --release -- --ignored`).

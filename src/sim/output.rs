@@ -352,11 +352,14 @@ pub fn record(sim: &mut Simulation, mut progress: impl FnMut(f64)) -> Result<Rec
     let n_wheels = sim.wheels.len();
     let mut peak = vec![0.0f64; n_wheels];
     let mut sums = vec![(0.0, 0.0); n_wheels];
-    let wheel_col = rec
-        .names()
-        .iter()
-        .position(|n| n == "w1l_force_y")
-        .unwrap_or(2);
+    // Each wheel's recorded Y and Q columns, found by name.
+    let column = |name: String| rec.names().iter().position(|n| *n == name);
+    let yq_cols: Vec<Option<(usize, usize)>> = (0..n_wheels)
+        .map(|k| {
+            let w = super::wheel_name(k).to_ascii_lowercase();
+            column(format!("w{w}_force_y")).zip(column(format!("w{w}_force_z")))
+        })
+        .collect();
     let static_load =
         sim.vehicle().mass() * crate::GRAVITY / sim.vehicle().contact.wheelsets.len() as f64 / 2.0;
     let total_steps = crate::bounds::count_of(duration / sim.config().dt, "steps of the run")?;
@@ -378,9 +381,10 @@ pub fn record(sim: &mut Simulation, mut progress: impl FnMut(f64)) -> Result<Rec
             }
             // Y/Q from the recorded (filtered) forces, where the wheel carries at least 10 %
             // of its static load (Y/Q of an unloaded wheel means nothing).
-            for (k, p) in peak.iter_mut().enumerate() {
-                let (y, q) = (row[wheel_col + 7 * k], row[wheel_col + 7 * k + 1]);
-                if q > 0.1 * static_load {
+            for (p, cols) in peak.iter_mut().zip(&yq_cols) {
+                if let Some((y, q)) = cols.map(|(y, q)| (row[y], row[q]))
+                    && q > 0.1 * static_load
+                {
                     *p = p.max((y / q).abs());
                 }
             }
