@@ -26,7 +26,7 @@ pub use quasi_static::{QuasiStatic, StateResult, WheelResult, WheelsetState};
 pub use table::ContactTable;
 pub use wheel_rail::{
     CREEP_SPEED_FLOOR, ContactFrame, ContactModel, GAUGE_FACE_ANGLE, PatchForce, WheelForces,
-    WheelOnRail, evaluate, height_for_load,
+    WheelOnRail, evaluate, evaluate_into, height_for_load,
 };
 
 /// Nadal's flange-climb limit `(tan δ − μ)/(1 + μ·tan δ)` of |Y|/Q for the flange angle δ

@@ -118,7 +118,7 @@ pub struct PatchForce {
 }
 
 /// Everything the rail does to one wheel.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct WheelForces {
     /// The patches, the larger load first.
     pub patches: [Option<PatchForce>; 2],
@@ -211,6 +211,19 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// # Ok::<(), railforce::Error>(())
 /// ```
 pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> WheelForces {
+    let mut out = WheelForces::default();
+    evaluate_into(table, model, w, &mut out);
+    out
+}
+
+/// [`evaluate`] into `out` (overwritten whole): a step's loop keeps one and spares the copies
+/// of a large result.
+pub fn evaluate_into(
+    table: &ContactTable,
+    model: &ContactModel,
+    w: &WheelOnRail,
+    out: &mut WheelForces,
+) {
     let k = match w.side {
         Side::Left => 0,
         Side::Right => 1,
@@ -231,9 +244,9 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
     let speed = w.speed.abs().max(CREEP_SPEED_FLOOR);
     let (sy, cy) = crate::angle::sin_cos(w.yaw);
     let (sr, cr) = crate::angle::sin_cos(droll);
-    let mut patches: [Option<PatchForce>; 2] = [None, None];
+    out.patches = [None, None];
     let (mut force, mut moment) = ([0.0; 3], [0.0; 3]);
-    for (slot, load) in patches.iter_mut().zip(loads) {
+    for (slot, load) in out.patches.iter_mut().zip(loads) {
         let Some(l) = load else { continue };
         // Load centre from the table (zero yaw, table roll), turned by the extra roll and the
         // yaw so it stays on the spinning wheel (else the spin about a slightly tilted axle
@@ -307,6 +320,7 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
             approach_rate: rate,
         });
     }
+    let patches = &mut out.patches;
     if let [Some(a), Some(b)] = &patches
         && b.normal > a.normal
     {
@@ -315,14 +329,11 @@ pub fn evaluate(table: &ContactTable, model: &ContactModel, w: &WheelOnRail) -> 
     if patches[0].is_none() && patches[1].is_some() {
         patches.swap(0, 1);
     }
-    WheelForces {
-        patches,
-        force,
-        moment,
-        gap,
-        rigid_angle,
-        rigid_radius,
-    }
+    out.force = force;
+    out.moment = moment;
+    out.gap = gap;
+    out.rigid_angle = rigid_angle;
+    out.rigid_radius = rigid_radius;
 }
 
 /// Largest approach, either way, that [`height_for_load`] searches, m.

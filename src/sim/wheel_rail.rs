@@ -5,7 +5,7 @@
 
 use super::Simulation;
 use super::wheelset_solve::{RailCoupling, Shares};
-use crate::contact::{Creepage, Side, WheelOnRail, evaluate};
+use crate::contact::{Creepage, Side, WheelForces, WheelOnRail, evaluate_into};
 use crate::error::Result;
 use crate::track::discrete::Lever;
 use nalgebra::{Matrix6, Vector2, Vector3};
@@ -195,6 +195,7 @@ impl Simulation<'_> {
         let cs = &v.contact;
         let model = cs.model();
         let shares = self.shares;
+        let mut out = WheelForces::default();
         for (w, &b) in cs.wheelsets.iter().enumerate() {
             let f = &self.frames[b];
             let (inputs, y_centre) = self.wheels_on_rails(w);
@@ -207,10 +208,10 @@ impl Simulation<'_> {
                 if rail.roll != 0.0 || rail.roll_rate != 0.0 {
                     self.on_rolled_rail(&mut wr, k, &rail);
                 }
-                let out = super::profile::timed!(
+                super::profile::timed!(
                     self.profile,
                     "  of which the patch solve (8 wheels)",
-                    evaluate(self.table, &model, &wr)
+                    evaluate_into(self.table, &model, &wr, &mut out)
                 );
                 self.inputs[idx] = wr;
                 if let Some(Shares { theta, alpha_dt }) = shares {
