@@ -62,6 +62,11 @@ impl Sines {
     pub fn padded(n: usize) -> usize {
         n.div_ceil(LANES) * LANES
     }
+
+    /// `low` and `high` side by side, [`LANES`] wavenumbers at a time.
+    fn blocks(&self) -> impl Iterator<Item = (&Lanes, &Lanes)> {
+        (self.low.as_chunks::<LANES>().0.iter()).zip(self.high.as_chunks::<LANES>().0)
+    }
 }
 
 /// One direction of the track (`D` degrees of freedom per wavenumber, `R` rail fields): every
@@ -143,24 +148,28 @@ impl<const D: usize, const R: usize, const S: usize> Direction<D, R, S> {
         }
     }
 
-    /// Slot `i`'s degree of freedom (slot `2j` field j's wavenumber k, `2j + 1` its folded).
-    fn slot_dof(&self, i: usize) -> usize {
-        let (lo, fo) = self.fields[i / 2];
-        if i.is_multiple_of(2) { lo } else { fo }
+    /// Each slot's degree of freedom (slot `2j` field j's wavenumber k, `2j + 1` its folded).
+    fn dofs(&self) -> [usize; S] {
+        std::array::from_fn(|i| {
+            let (lo, fo) = self.fields[i / 2];
+            if i.is_multiple_of(2) { lo } else { fo }
+        })
+    }
+
+    /// How many wavenumbers each block of [`LANES`] holds (the last may hold fewer).
+    fn filled(&self) -> impl Iterator<Item = usize> {
+        let n = self.states.len();
+        (0..n.div_ceil(LANES)).map(move |b| (n - b * LANES).min(LANES))
     }
 
     /// The rail's displacement and velocity along `c` at the point whose sines are `s`.
     pub fn point(&self, s: &Sines, c: &[f64; R]) -> (f64, f64) {
         let pp = &self.pinned_state;
         let (mut x, mut v) = (0.0, 0.0);
-        let sines = || (s.low.as_chunks::<LANES>().0.iter()).zip(s.high.as_chunks::<LANES>().0);
         for (j, cj) in nonzero(c) {
             let (mut xj, mut vj) = (s.pinned * pp.x[j], s.pinned * pp.v[j]);
             for (acc, field) in [(&mut xj, &self.x_rail), (&mut vj, &self.v_rail)] {
-                let mut left = self.states.len();
-                for (f, (a, b)) in field.iter().zip(sines()) {
-                    let len = left.min(LANES);
-                    left -= len;
+                for ((f, (a, b)), len) in field.iter().zip(s.blocks()).zip(self.filled()) {
                     let t: Lanes =
                         std::array::from_fn(|q| a[q] * f[2 * j][q] + b[q] * f[2 * j + 1][q]);
                     add_in_order(acc, &t[..len]);
@@ -175,7 +184,7 @@ impl<const D: usize, const R: usize, const S: usize> Direction<D, R, S> {
     /// Copies the rail degrees of freedom's displacements and velocities into the blocks that
     /// [`Direction::point`] sweeps.
     fn mirror_rails(&mut self) {
-        let dofs: [usize; S] = std::array::from_fn(|i| self.slot_dof(i));
+        let dofs = self.dofs();
         for (k, st) in self.states.iter().enumerate() {
             let (xb, vb) = (&mut self.x_rail[k / LANES], &mut self.v_rail[k / LANES]);
             for (i, &d) in dofs.iter().enumerate() {
@@ -206,7 +215,7 @@ impl<const D: usize, const R: usize, const S: usize> Direction<D, R, S> {
     /// `Δv = −Δt·inv·((K + B)·x + (C + Δt·B)·v)`, column by column (lanes along the rows).
     #[inline(always)]
     fn begin_lanes(&mut self) {
-        let dofs: [usize; S] = std::array::from_fn(|i| self.slot_dof(i));
+        let dofs = self.dofs();
         for (k, (st, sys)) in self.states.iter_mut().zip(&self.systems).enumerate() {
             let mut dv = [0.0; D];
             let columns = (sys.from_x.as_slice().chunks_exact(D))
@@ -292,13 +301,9 @@ impl<const D: usize, const R: usize, const S: usize> Direction<D, R, S> {
         let list = &list[..len];
         // Four wavenumbers at a time: each one's numbers lane by lane, then its terms added in
         // the wavenumbers' order.
-        let mut left = self.states.len();
         let mut t = [0.0; LANES];
-        let sines = (s.low.as_chunks::<LANES>().0.iter()).zip(s.high.as_chunks::<LANES>().0);
         let blocks = (self.imp.iter()).zip(&self.rail_inv).zip(&self.free_dv);
-        for (((imp, ri), free), (a, b)) in blocks.zip(sines) {
-            let len = left.min(LANES);
-            left -= len;
+        for ((((imp, ri), free), (a, b)), len) in blocks.zip(s.blocks()).zip(self.filled()) {
             for (x, &j) in list.iter().enumerate() {
                 let (r_lo, r_fo) = (&ri[2 * j], &ri[2 * j + 1]);
                 // The rail slots' velocity change: the free one and the inverse's row times
@@ -366,11 +371,10 @@ impl<const D: usize, const R: usize, const S: usize> Direction<D, R, S> {
             self.states.len().div_ceil(LANES),
             "factor() first"
         );
-        let sines = || (s.low.as_chunks::<LANES>().0.iter()).zip(s.high.as_chunks::<LANES>().0);
         for (j, cj) in nonzero(c) {
             self.pinned_state.dv += self.pinned.inv.column(j) * (g * cj * s.pinned);
             let gc = g * cj;
-            for (imp, (a, b)) in self.imp.iter_mut().zip(sines()) {
+            for (imp, (a, b)) in self.imp.iter_mut().zip(s.blocks()) {
                 for q in 0..LANES {
                     imp[2 * j][q] += gc * a[q];
                     imp[2 * j + 1][q] += gc * b[q];
@@ -430,7 +434,7 @@ impl<const D: usize, const R: usize, const S: usize> Direction<D, R, S> {
         self.systems.iter_mut().for_each(|s| s.factor(dt, FOLLOWED));
         // No pad reaches the pinned–pinned modes, so nothing else damps them.
         self.pinned.factor(dt, 0.0);
-        let dofs: [usize; S] = std::array::from_fn(|i| self.slot_dof(i));
+        let dofs = self.dofs();
         let blocks = self.systems.len().div_ceil(LANES);
         self.imp = vec![[[0.0; LANES]; S]; blocks];
         self.free_dv = vec![[[0.0; LANES]; S]; blocks];
