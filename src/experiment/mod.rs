@@ -18,6 +18,8 @@ mod mismatch;
 mod model_form;
 mod paper;
 mod protocols;
+mod provenance;
+use provenance::{cores, cpu_seconds, source_commit, unix_now};
 mod robustness;
 mod sensors;
 mod snapshot;
@@ -407,37 +409,6 @@ fn train_metrics(model: &mut Model, ds: &DataSet) -> Result<Vec<Metrics>> {
     Ok(metrics(&y, &p, &stats.1))
 }
 
-/// Seconds since 1970-01-01 UTC (0 when the clock is before it).
-fn unix_now() -> u64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs())
-}
-
-/// The commit of the source tree this binary was built from (`git rev-parse HEAD` in it, with
-/// `-modified` when tracked files differ from it), or "unknown" where that tree is gone: the
-/// results snapshot names the code that measured it.
-fn source_commit() -> String {
-    let git = |args: &[&str]| {
-        std::process::Command::new("git")
-            .arg("-C")
-            .arg(env!("CARGO_MANIFEST_DIR"))
-            .args(args)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
-    match git(&["rev-parse", "HEAD"]) {
-        Some(h) if !h.is_empty() => {
-            let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
-                .is_some_and(|s| !s.is_empty());
-            if dirty { format!("{h}-modified") } else { h }
-        }
-        _ => "unknown".into(),
-    }
-}
-
 fn f4(v: f64) -> String {
     format!("{v:.4}")
 }
@@ -470,7 +441,7 @@ pub fn run(
     opts: &ExperimentOptions,
     log: &(dyn Fn(String) + Sync),
 ) -> Result<PathBuf> {
-    let t0 = Instant::now();
+    let (t0, cpu0) = (Instant::now(), cpu_seconds());
     let plan = Plan::load(&opts.plan)?;
     let data_dir = opts.out.join("data");
     let mut parts: Vec<Which> = Vec::new();
@@ -551,10 +522,12 @@ pub fn run(
         "railforce_version": env!("CARGO_PKG_VERSION"),
         "commit": source_commit(),
         "started_unix": unix_now(),
+        "cores": cores(),
     });
-    let mut took: Vec<(&str, f64)> = Vec::new();
+    let mut took: Vec<(&str, f64, Option<f64>)> = Vec::new();
+    let cpu_since = |c: Option<f64>| Some(cpu_seconds()? - c?);
     for part in parts.clone() {
-        let ts = Instant::now();
+        let (ts, cs) = (Instant::now(), cpu_seconds());
         let mut sec = match part {
             Which::Comparison => comparison::run(&mut ctx)?,
             Which::Generalization => generalization::run(&mut ctx)?,
@@ -564,7 +537,7 @@ pub fn run(
             Which::ModelForm => model_form::run(&mut ctx)?,
             _ => mismatch::run(&mut ctx)?,
         };
-        let secs = ts.elapsed().as_secs_f64();
+        let (secs, cpu) = (ts.elapsed().as_secs_f64(), cpu_since(cs));
         let folder = part.folder();
         // Each part says where it comes from: parts run at different times into one folder
         // keep their own provenance.
@@ -583,25 +556,30 @@ pub fn run(
         sec.write_files(&opts.out.join(folder))?;
         let mut pm = common.clone();
         pm["wall_seconds"] = json!(secs);
+        pm["cpu_seconds"] = json!(cpu);
         let pj = serde_json::to_string_pretty(&pm).expect("meta serialises");
         crate::io::write_atomic(&opts.out.join(folder).join("meta.json"), |w| {
             w.write_all(pj.as_bytes())
         })?;
         timings.insert(format!("{folder}_s"), json!(secs));
-        took.push((folder, secs));
+        took.push((folder, secs, cpu));
     }
-    let wall = t0.elapsed().as_secs_f64();
-    log("wall time of each part:".into());
-    for (folder, secs) in &took {
-        log(format!("  {folder:<15} {}", snapshot::minutes(*secs)));
+    let (wall, cpu) = (t0.elapsed().as_secs_f64(), cpu_since(cpu0));
+    log(format!(
+        "wall time of each part, and the CPU time its threads used ({} cores):",
+        cores()
+    ));
+    for (folder, secs, cpu) in &took {
+        log(format!("  {folder:<15} {}", snapshot::busy(*secs, *cpu)));
     }
     log(format!(
         "  {:<15} {} (simulating the plan's data and the rest)",
         "in all",
-        snapshot::minutes(wall)
+        snapshot::busy(wall, cpu)
     ));
     let mut meta = common.clone();
     meta["wall_seconds"] = json!(wall);
+    meta["cpu_seconds"] = json!(cpu);
     meta["finished_unix"] = json!(unix_now());
     meta["timings"] = json!(timings);
     let mj = serde_json::to_string_pretty(&meta).expect("meta serialises");

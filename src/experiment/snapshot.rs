@@ -142,26 +142,41 @@ pub(super) fn render(out: &Path, dest: &Path) -> Result<String> {
     md += "## Headline\n\n";
     md += &headline_block(out)?;
     md += "\n## Wall time of each part\n\n";
-    let mut wt = Table::new(&["part", "commit", "wall time"]);
+    md += &format!(
+        "CPU time: every thread's user and system time while the part ran; cores busy: CPU time over wall time, of the {} the run had. A part that keeps every core busy is bound by its work, not by its order.\n\n",
+        meta["cores"].as_u64().map_or("?".into(), |n| n.to_string())
+    );
+    let mut wt = Table::new(&WALL_HEADER);
     for (f, m) in &parts {
         if let Some(s) = m["wall_seconds"].as_f64() {
             let c = m["commit"].as_str().unwrap_or("unknown");
-            wt.push(vec![f.to_string(), c.chars().take(7).collect(), minutes(s)]);
+            let mut row = vec![f.to_string(), c.chars().take(7).collect()];
+            row.extend(wall_cells(s, m["cpu_seconds"].as_f64()));
+            wt.push(row);
         }
     }
-    wt.push(vec![
+    let (total, total_cpu) = if one_run {
+        (
+            meta["wall_seconds"].as_f64().unwrap_or(0.0),
+            meta["cpu_seconds"].as_f64(),
+        )
+    } else {
+        let cpu: Option<f64> = (parts.iter())
+            .filter(|(_, m)| m["wall_seconds"].is_number())
+            .map(|(_, m)| m["cpu_seconds"].as_f64())
+            .sum();
+        (parts_wall, cpu)
+    };
+    let mut row = vec![
         if missing.is_empty() && one_run {
             "all, with the simulation of the data".into()
         } else {
             "the parts above, added".into()
         },
         String::new(),
-        minutes(if one_run {
-            meta["wall_seconds"].as_f64().unwrap_or(0.0)
-        } else {
-            parts_wall
-        }),
-    ]);
+    ];
+    row.extend(wall_cells(total, total_cpu));
+    wt.push(row);
     md += &wt.markdown();
     // The experiments' parts, then a sensitivity study run into the same folder
     // (`railforce sensitivity --out OUT/sensitivity`): the labels' own uncertainty beside the
@@ -201,6 +216,8 @@ pub(super) fn render(out: &Path, dest: &Path) -> Result<String> {
 fn partial_meta(out: &Path) -> Option<(serde_json::Value, Vec<String>)> {
     let mut meta: Option<serde_json::Value> = None;
     let (mut timings, mut missing) = (serde_json::Map::new(), Vec::new());
+    // The parts' CPU time added, while every part recorded one.
+    let mut cpu = Some(0.0);
     let mut last = 0u64;
     for f in Which::FOLDERS {
         let p = out.join(f).join("meta.json");
@@ -211,6 +228,7 @@ fn partial_meta(out: &Path) -> Option<(serde_json::Value, Vec<String>)> {
             (Some(m), Some(_)) => {
                 if let Some(s) = m["wall_seconds"].as_f64() {
                     timings.insert(format!("{f}_s"), serde_json::json!(s));
+                    cpu = cpu.zip(m["cpu_seconds"].as_f64()).map(|(a, b)| a + b);
                 }
                 let modified = std::fs::metadata(&p)
                     .and_then(|md| md.modified())
@@ -225,6 +243,7 @@ fn partial_meta(out: &Path) -> Option<(serde_json::Value, Vec<String>)> {
     }
     let mut meta = meta?;
     let total: f64 = timings.values().filter_map(|v| v.as_f64()).sum();
+    meta["cpu_seconds"] = serde_json::json!(cpu);
     meta["timings"] = serde_json::Value::Object(timings);
     meta["wall_seconds"] = serde_json::json!(total);
     meta["finished_unix"] = serde_json::json!(last);
@@ -492,6 +511,26 @@ fn range(t: &Table, rows: &[&Vec<String>], column: &str) -> String {
     let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
     let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     format!("{lo:.3} – {hi:.3}")
+}
+
+/// The wall-time table's columns (`experiment snapshot --merge` keeps them).
+pub(super) const WALL_HEADER: [&str; 5] = ["part", "commit", "wall time", "CPU time", "cores busy"];
+
+/// A part's wall time, CPU time and cores busy as table cells ("—" where the CPU time was
+/// not recorded).
+pub(super) fn wall_cells(wall: f64, cpu: Option<f64>) -> [String; 3] {
+    match cpu {
+        Some(c) if wall > 0.0 => [minutes(wall), minutes(c), format!("{:.2}", c / wall)],
+        _ => [minutes(wall), "—".into(), "—".into()],
+    }
+}
+
+/// "12.3 min, CPU 23.1 min (1.88 cores busy)" for the log.
+pub(super) fn busy(wall: f64, cpu: Option<f64>) -> String {
+    match wall_cells(wall, cpu) {
+        [w, c, b] if c != "—" => format!("{w}, CPU {c} ({b} cores busy)"),
+        [w, ..] => w,
+    }
 }
 
 /// "12.3 min" (or seconds below a minute).

@@ -5,7 +5,7 @@
 //! The Run line then names each part's commit.
 
 use super::Which;
-use super::snapshot::{HEADLINE_BEGIN, HEADLINE_END, minutes};
+use super::snapshot::{HEADLINE_BEGIN, HEADLINE_END, minutes, wall_cells};
 
 /// The part each headline row comes from, by the start of its first cell (the rows
 /// [`super::snapshot`] writes).
@@ -165,6 +165,10 @@ pub fn merge(old: &str, new: &str) -> String {
     let total: f64 = (wall.iter())
         .filter_map(|(_, r)| cells(r).get(2).and_then(|c| seconds(c)))
         .sum();
+    // CPU time added while every part's row has one (rows from before the column have none).
+    let total_cpu: Option<f64> = (wall.iter())
+        .map(|(_, r)| cells(r).get(3).and_then(|c| seconds(c)))
+        .sum();
     let mut out = String::new();
     for line in &o.preamble {
         if line.starts_with("- **Run:**") {
@@ -203,16 +207,29 @@ pub fn merge(old: &str, new: &str) -> String {
                 out += &format!("{HEADLINE_END}\n\n");
             }
             WALL => {
+                // The newer snapshot's words and columns, each part's row from its own run.
+                let body = n.section(WALL).unwrap_or(body);
                 out += &format!("## {title}\n");
+                for l in body.iter().take_while(|l| !l.starts_with("| ")) {
+                    out += &format!("{l}\n");
+                }
                 let head = body.iter().find(|l| l.starts_with("| "));
-                out.push('\n');
+                let width = head.map_or(3, |h| cells(h).len());
                 if let Some(h) = head {
                     out += &format!("{h}\n{}\n", rule(h));
                 }
+                let pad = |mut c: Vec<String>| {
+                    c.resize(width.max(c.len()), "—".into());
+                    c.truncate(width);
+                    format!("| {} |\n", c.join(" | "))
+                };
                 for (_, r) in &wall {
-                    out += &format!("{r}\n");
+                    out += &pad(cells(r));
                 }
-                out += &format!("| the parts above, added |  | {} |\n\n", minutes(total));
+                let mut last = vec!["the parts above, added".to_string(), String::new()];
+                last.extend(wall_cells(total, total_cpu));
+                out += &pad(last);
+                out.push('\n');
             }
             _ => {
                 let replaced = (n.sections.iter()).find(|(t, _)| key(t) == key(title));
@@ -385,5 +402,49 @@ mod tests {
         );
         // Merging the same again changes nothing.
         assert_eq!(merge(&m, &new), m);
+    }
+
+    /// A part run with the CPU column merged into a snapshot from before it: the newer
+    /// columns, the older rows padded with "—", and the total's CPU time unknown until every
+    /// part has one.
+    #[test]
+    fn the_cpu_column_pads_rows_from_before_it() {
+        let wall = |rows: &[&str]| {
+            snapshot(
+                "- **Run:** finished {OLD} (UTC), railforce 0.1.0, commit `aaaa` (comparison, model_form), its parts run into one folder at different times, 10.0 min of wall time added.",
+                &[],
+                rows,
+                &[],
+            )
+        };
+        let old = wall(&[
+            "| comparison | aaaa | 2.0 min |",
+            "| model_form | aaaa | 8.0 min |",
+        ]);
+        let new = wall(&["| model_form | cccc | 6.0 min | 11.4 min | 1.90 |"]).replace(
+            "| part | commit | wall time |\n|---|---|---|",
+            "CPU time: words.\n\n| part | commit | wall time | CPU time | cores busy |\n|---|---|---|---|---|",
+        );
+        let m = merge(&old, &new);
+        assert!(m.contains("CPU time: words."), "{m}");
+        assert!(
+            m.contains("| comparison | aaaa | 2.0 min | — | — |")
+                && m.contains("| model_form | cccc | 6.0 min | 11.4 min | 1.90 |")
+                && m.contains("| the parts above, added |  | 8.0 min | — | — |"),
+            "{m}"
+        );
+        let both = wall(&[
+            "| comparison | cccc | 2.0 min | 3.0 min | 1.50 |",
+            "| model_form | cccc | 6.0 min | 11.4 min | 1.90 |",
+        ])
+        .replace(
+            "| part | commit | wall time |\n|---|---|---|",
+            "| part | commit | wall time | CPU time | cores busy |\n|---|---|---|---|---|",
+        );
+        let m = merge(&m, &both);
+        assert!(
+            m.contains("| the parts above, added |  | 8.0 min | 14.4 min | 1.80 |"),
+            "{m}"
+        );
     }
 }
