@@ -140,6 +140,27 @@ fn every_experiment_runs_end_to_end() {
     assert_eq!(meta["window"], 12);
     assert_eq!(meta["label_at"], "Centre");
     assert_eq!(meta["noise"]["reference"], "std");
+    // CPU time: positive, and no more than every core busy for the whole wall time.
+    let (wall, cpu) = (
+        meta["wall_seconds"].as_f64().unwrap(),
+        meta["cpu_seconds"].as_f64().unwrap(),
+    );
+    let cores = meta["cores"].as_f64().unwrap();
+    assert!(
+        cpu > 0.0 && cpu <= wall * cores * 1.05 + 0.5,
+        "{cpu} s CPU in {wall} s on {cores}"
+    );
+    assert!(meta["machine"].as_str().unwrap().ends_with(" cores"));
+    let snapshot = std::fs::read_to_string(out.join("results.md")).unwrap();
+    assert!(
+        snapshot.contains("| part | commit | wall time | CPU time | cores busy | machine |"),
+        "{snapshot}"
+    );
+    let part: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("generalization/meta.json")).unwrap(),
+    )
+    .unwrap();
+    assert!(part["cpu_seconds"].as_f64().unwrap() > 0.0);
     let protocols = std::fs::read_to_string(out.join("protocols/protocols.csv")).unwrap();
     assert!(protocols.starts_with("protocol,"), "{protocols}");
     assert!(protocols.contains("shuffled (leaky)") && protocols.contains("SHUFFLED (leaky)"));

@@ -117,13 +117,13 @@ pub struct ExperimentArgs {
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=32))]
     mismatch_members: u16,
     /// Also write the results snapshot here (it is always written to --out/results.md): the
-    /// date, commit, version, protocol, wall time of each part, a headline table and every
+    /// date, commit, version, protocol, wall and CPU time of each part, a headline table and every
     /// table and figure, from the run's own files; figures are copied beside it under
     /// results/. The project's is assets/docs/results.md.
     #[arg(long)]
     results: Option<PathBuf>,
     /// With snapshot: replace in the existing --results file only the parts --out holds (their
-    /// sections, headline rows, wall times and commits), keeping the others as they were
+    /// sections, headline rows, wall and CPU times and commits), keeping the others as they were
     /// measured; for one part run again after a change that touched its data alone.
     #[arg(long)]
     merge: bool,

@@ -176,12 +176,12 @@ enum Command {
     /// nominal against fleet-trained) and the simulator's own form (model-form: lumped track
     /// against rails on sleepers). Defaults: split by seed (independent test runs), 6 dB with
     /// σ from each channel's std, centre label. Writes tables (Markdown, CSV), SVG figures and
-    /// index.html with the paper's numbers beside ours, and prints each part's wall time at
-    /// the end. A run of all seven writes results.md, the snapshot of what it measured (date,
-    /// commit, protocol, the wall time of each part, every table); `experiment snapshot`
-    /// rewrites it from a finished folder. The full protocol on the paper's 34 conditions
-    /// takes hours on two cores, most of it training (results.md records each part's wall
-    /// time).
+    /// index.html with the paper's numbers beside ours, and prints each part's wall time and
+    /// CPU time at the end. A run of all seven writes results.md, the snapshot of what it
+    /// measured (date, commit, protocol, the wall and CPU time of each part, every table);
+    /// `experiment snapshot` rewrites it from a finished folder. The full protocol on the
+    /// paper's 34 conditions takes hours on two cores, most of it training (results.md
+    /// records each part's wall and CPU time).
     #[command(
         after_help = "Examples:\n  railforce experiment comparison --plan demo --out experiments --epochs 2 --windows-per-epoch 2000"
     )]

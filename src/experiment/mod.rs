@@ -19,7 +19,7 @@ mod model_form;
 mod paper;
 mod protocols;
 mod provenance;
-use provenance::{cores, cpu_seconds, source_commit, unix_now};
+use provenance::{cores, cpu_seconds, machine, source_commit, unix_now};
 mod robustness;
 mod sensors;
 mod snapshot;
@@ -523,6 +523,7 @@ pub fn run(
         "commit": source_commit(),
         "started_unix": unix_now(),
         "cores": cores(),
+        "machine": machine(),
     });
     let mut took: Vec<(&str, f64, Option<f64>)> = Vec::new();
     let cpu_since = |c: Option<f64>| Some(cpu_seconds()? - c?);

@@ -57,6 +57,23 @@ pub(super) fn cpu_seconds() -> Option<f64> {
     }
 }
 
+/// The machine in words: the processor's model name (`/proc/cpuinfo`, where there is one) and
+/// the cores the run had, e.g. "AMD EPYC, 2 cores". Timings from different machines sit side
+/// by side in a merged snapshot, so each part names its own.
+pub(super) fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            (t.lines())
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, m)| m.split_whitespace().collect::<Vec<_>>().join(" "))
+        })
+        .filter(|m| !m.is_empty())
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    format!("{model}, {} cores", cores())
+}
+
 /// The cores this machine offers the run (1 where it cannot say).
 pub(super) fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
@@ -64,19 +81,26 @@ pub(super) fn cores() -> usize {
 
 #[cfg(test)]
 mod tests {
-    /// Spinning one thread for a while costs about that while in CPU time: the clock read is
-    /// the process's own, not the wall's.
+    /// Work costs CPU time: the clock read grows while a thread computes. (The spin waits on
+    /// the CPU clock itself, so a busy machine only makes it take longer.)
     #[test]
     #[cfg(unix)]
     fn cpu_time_grows_with_work() {
         let a = super::cpu_seconds().expect("getrusage on unix");
         let t = std::time::Instant::now();
         let mut x = 1.0f64;
-        while t.elapsed().as_secs_f64() < 0.2 {
-            x = std::hint::black_box(x * 1.000_000_1 + 1e-9);
+        let mut b = a;
+        while b - a < 0.1 && t.elapsed().as_secs_f64() < 10.0 {
+            for _ in 0..100_000 {
+                x = std::hint::black_box(x * 1.000_000_1 + 1e-9);
+            }
+            b = super::cpu_seconds().expect("getrusage on unix");
         }
-        let b = super::cpu_seconds().expect("getrusage on unix");
-        assert!(b - a > 0.1, "spun 0.2 s, CPU grew {:.3} s", b - a);
+        assert!(
+            b - a >= 0.1,
+            "spun 10 s of wall time, CPU grew {:.3} s",
+            b - a
+        );
         assert!(x.is_finite());
     }
 }

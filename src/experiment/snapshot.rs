@@ -1,7 +1,7 @@
 //! The results snapshot: `results.md` written from a finished run's own files (`meta.json`
 //! and each part's `section.json`), so the figures a reader quotes are the ones the run
 //! measured. It carries the date, the commit and the binary's version, every protocol line,
-//! the wall time of each part, a headline table picked from the parts' tables, and every
+//! the wall and CPU time of each part, a headline table picked from the parts' tables, and every
 //! table and figure of every part. The README quotes the headline table between
 //! [`HEADLINE_BEGIN`] and [`HEADLINE_END`] (a test holds the two equal).
 
@@ -142,16 +142,14 @@ pub(super) fn render(out: &Path, dest: &Path) -> Result<String> {
     md += "## Headline\n\n";
     md += &headline_block(out)?;
     md += "\n## Wall time of each part\n\n";
-    md += &format!(
-        "CPU time: every thread's user and system time while the part ran; cores busy: CPU time over wall time, of the {} the run had. A part that keeps every core busy is bound by its work, not by its order.\n\n",
-        meta["cores"].as_u64().map_or("?".into(), |n| n.to_string())
-    );
+    md += "CPU time: every thread's user and system time while the part ran; cores busy: CPU time over wall time, of the cores its machine had (last column). A part that keeps every core busy is bound by its work, not by the order of its jobs.\n\n";
     let mut wt = Table::new(&WALL_HEADER);
     for (f, m) in &parts {
         if let Some(s) = m["wall_seconds"].as_f64() {
             let c = m["commit"].as_str().unwrap_or("unknown");
             let mut row = vec![f.to_string(), c.chars().take(7).collect()];
             row.extend(wall_cells(s, m["cpu_seconds"].as_f64()));
+            row.push(m["machine"].as_str().unwrap_or("—").to_string());
             wt.push(row);
         }
     }
@@ -176,6 +174,7 @@ pub(super) fn render(out: &Path, dest: &Path) -> Result<String> {
         String::new(),
     ];
     row.extend(wall_cells(total, total_cpu));
+    row.push(String::new());
     wt.push(row);
     md += &wt.markdown();
     // The experiments' parts, then a sensitivity study run into the same folder
@@ -514,7 +513,14 @@ fn range(t: &Table, rows: &[&Vec<String>], column: &str) -> String {
 }
 
 /// The wall-time table's columns (`experiment snapshot --merge` keeps them).
-pub(super) const WALL_HEADER: [&str; 5] = ["part", "commit", "wall time", "CPU time", "cores busy"];
+pub(super) const WALL_HEADER: [&str; 6] = [
+    "part",
+    "commit",
+    "wall time",
+    "CPU time",
+    "cores busy",
+    "machine",
+];
 
 /// A part's wall time, CPU time and cores busy as table cells ("—" where the CPU time was
 /// not recorded).

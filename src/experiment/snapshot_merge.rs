@@ -207,8 +207,15 @@ pub fn merge(old: &str, new: &str) -> String {
                 out += &format!("{HEADLINE_END}\n\n");
             }
             WALL => {
-                // The newer snapshot's words and columns, each part's row from its own run.
-                let body = n.section(WALL).unwrap_or(body);
+                // The wider table's words and columns (the newer's where both are as wide),
+                // each part's row from its own run.
+                let width_of = |b: &Vec<String>| {
+                    (b.iter().find(|l| l.starts_with("| "))).map_or(0, |h| cells(h).len())
+                };
+                let body = match n.section(WALL) {
+                    Some(nb) if width_of(nb) >= width_of(body) => nb,
+                    _ => body,
+                };
                 out += &format!("## {title}\n");
                 for l in body.iter().take_while(|l| !l.starts_with("| ")) {
                     out += &format!("{l}\n");
@@ -228,6 +235,7 @@ pub fn merge(old: &str, new: &str) -> String {
                 }
                 let mut last = vec!["the parts above, added".to_string(), String::new()];
                 last.extend(wall_cells(total, total_cpu));
+                last.push(String::new());
                 out += &pad(last);
                 out.push('\n');
             }
@@ -432,6 +440,14 @@ mod tests {
                 && m.contains("| model_form | cccc | 6.0 min | 11.4 min | 1.90 |")
                 && m.contains("| the parts above, added |  | 8.0 min | — | — |"),
             "{m}"
+        );
+        // A snapshot from before the column merged into one with it keeps the column.
+        let back = merge(&m, &old);
+        assert!(
+            back.contains("CPU time: words.")
+                && back.contains("| part | commit | wall time | CPU time | cores busy |")
+                && back.contains("| model_form | aaaa | 8.0 min | — | — |"),
+            "{back}"
         );
         let both = wall(&[
             "| comparison | cccc | 2.0 min | 3.0 min | 1.50 |",
