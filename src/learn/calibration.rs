@@ -2,7 +2,7 @@
 //! kept as quantiles, and the interval they give at any coverage (how a model is calibrated:
 //! `learn::uncertainty`; assets/docs/learning.md §3.1).
 
-pub use super::difficulty::{CONTEXT_ROWS, Context, feature_count, features};
+pub use super::difficulty::{CONTEXT_ROWS, Context, WindowContexts, feature_count, features};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -363,14 +363,14 @@ impl Calibration {
     /// The context the difficulty of a run's windows reads, from the run's standardised
     /// inputs `[rows × c]` (`None` where the calibration reads none).
     pub fn context(&self, inputs: &[f32], c: usize) -> Option<Context> {
-        (self.context_rows > 0 && !self.difficulty.is_empty())
+        self.reads_context()
             .then(|| Context::new(inputs, c, self.context_rows))
     }
 
     /// An empty context for a stream of `c` channels (`None` where the calibration reads
     /// none).
     pub fn context_stream(&self, c: usize) -> Option<Context> {
-        (self.context_rows > 0 && !self.difficulty.is_empty())
+        self.reads_context()
             .then(|| Context::stream(c, self.context_rows))
     }
 
@@ -385,14 +385,33 @@ impl Calibration {
         prediction: &[f32],
         context: Option<(&Context, usize)>,
     ) -> Vec<f64> {
+        let ctx = match context {
+            Some((ctx, row)) if self.context_rows > 0 && !self.difficulty.is_empty() => {
+                Some(ctx.at(row))
+            }
+            _ => None,
+        };
+        self.difficulty_with(window, c, prediction, ctx.as_deref())
+    }
+
+    /// Whether the difficulty reads the run's context ([`Calibration::context`]).
+    pub fn reads_context(&self) -> bool {
+        self.context_rows > 0 && !self.difficulty.is_empty()
+    }
+
+    /// [`Calibration::difficulty_of`] with the window's context features already read
+    /// ([`Context::at`] or [`WindowContexts::at`]; `None` without a context).
+    pub fn difficulty_with(
+        &self,
+        window: &[f32],
+        c: usize,
+        prediction: &[f32],
+        context: Option<&[f64]>,
+    ) -> Vec<f64> {
         if self.difficulty.is_empty() {
             return vec![1.0; self.quantiles.len()];
         }
-        let ctx = match context {
-            Some((ctx, row)) if self.context_rows > 0 => ctx.at(row),
-            _ => Vec::new(),
-        };
-        let f = features(window, c, prediction, &ctx);
+        let f = features(window, c, prediction, context.unwrap_or(&[]));
         self.difficulty
             .iter()
             .map(|w| {

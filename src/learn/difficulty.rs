@@ -93,6 +93,82 @@ impl Context {
     }
 }
 
+/// The context features ([`Context::at`]) of windows met one by one in any order, each run's
+/// running sums built once. Windows that come run after run (a split by seeds, blocks or
+/// conditions) stream through one run's sums at a time; windows in no run order (a shuffled
+/// split) get theirs computed run by run beforehand, `3c` values a window, where building a
+/// run's sums for each window anew cost minutes. Either way a window's features are the same
+/// numbers.
+#[derive(Debug, Clone)]
+pub struct WindowContexts {
+    c: usize,
+    span: usize,
+    /// The run whose sums are built, and the sums.
+    current: Option<(usize, Context)>,
+    /// Every window's features, `3c` a window, where the windows come in no run order.
+    ahead: Vec<f64>,
+}
+
+impl WindowContexts {
+    /// For `n` windows: window `i` belongs to run `place(i).0` and ends at its row
+    /// `place(i).1`; `inputs(run)` is a run's standardised inputs `[rows × c]`.
+    pub fn new<'a>(
+        n: usize,
+        place: impl Fn(usize) -> (usize, usize),
+        inputs: impl Fn(usize) -> &'a [f32],
+        c: usize,
+        span: usize,
+    ) -> Self {
+        let mut me = WindowContexts {
+            c: c.max(1),
+            span,
+            current: None,
+            ahead: Vec::new(),
+        };
+        if (1..n).any(|i| place(i - 1).0 > place(i).0) {
+            let w = 3 * me.c;
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_by_key(|&i| place(i).0);
+            let mut ahead = vec![0.0; n * w];
+            for i in order {
+                let (run, last) = place(i);
+                ahead[i * w..(i + 1) * w].copy_from_slice(&me.streamed(run, last, &inputs));
+            }
+            (me.current, me.ahead) = (None, ahead);
+        }
+        me
+    }
+
+    fn streamed<'a>(
+        &mut self,
+        run: usize,
+        last: usize,
+        inputs: impl Fn(usize) -> &'a [f32],
+    ) -> Vec<f64> {
+        if self.current.as_ref().is_none_or(|(r, _)| *r != run) {
+            self.current = Some((run, Context::new(inputs(run), self.c, self.span)));
+        }
+        self.current
+            .as_ref()
+            .map_or_else(Vec::new, |(_, x)| x.at(last))
+    }
+
+    /// The context features of window `i`, of run `run`, ending at its row `last`.
+    pub fn at<'a>(
+        &mut self,
+        i: usize,
+        (run, last): (usize, usize),
+        inputs: impl Fn(usize) -> &'a [f32],
+    ) -> Vec<f64> {
+        if self.ahead.is_empty() {
+            self.streamed(run, last, inputs)
+        } else {
+            let w = 3 * self.c;
+            self.ahead[i * w..(i + 1) * w].to_vec()
+        }
+    }
+}
+
 /// The difficulty features of a standardised window `[steps × c]`, the model's standardised
 /// `prediction` for it and its `context` ([`Context::at`] of its last row, or empty): 1, then
 /// `ln(0.1 + rms)` of each channel over the window (the inputs' own level: faster, rougher or
@@ -150,6 +226,43 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
     use rand_chacha::rand_core::SeedableRng;
     use rand_distr::{Distribution, Normal};
+
+    /// Windows in no run order (a shuffled split) read the same context features as the
+    /// same windows run after run, to the bit.
+    #[test]
+    fn shuffled_windows_read_the_same_contexts_as_ordered_ones() {
+        let c = 3;
+        let runs: Vec<Vec<f32>> = (0..4)
+            .map(|r| {
+                (0..300 * c)
+                    .map(|k| ((k * 7 + r * 13) % 17) as f32 * 0.1 - 0.8)
+                    .collect()
+            })
+            .collect();
+        let ordered: Vec<(usize, usize)> = (0..4)
+            .flat_map(|r| (10..300).step_by(7).map(move |l| (r, l)))
+            .collect();
+        let mut shuffled = ordered.clone();
+        // A fixed permutation that mixes the runs.
+        shuffled.sort_by_key(|&(r, l)| (l * 31 + r * 97) % 101);
+        assert!(shuffled.windows(2).any(|w| w[0].0 > w[1].0));
+        let inputs = |r: usize| runs[r].as_slice();
+        let mut a = WindowContexts::new(ordered.len(), |i| ordered[i], inputs, c, 50);
+        let mut b = WindowContexts::new(shuffled.len(), |i| shuffled[i], inputs, c, 50);
+        let of_a: std::collections::HashMap<(usize, usize), Vec<u64>> = (0..ordered.len())
+            .map(|i| {
+                let f = a.at(i, ordered[i], inputs);
+                (ordered[i], f.iter().map(|v| v.to_bits()).collect())
+            })
+            .collect();
+        for (i, &p) in shuffled.iter().enumerate() {
+            let f: Vec<u64> = b.at(i, p, inputs).iter().map(|v| v.to_bits()).collect();
+            assert_eq!(f.len(), 3 * c);
+            assert_eq!(f, of_a[&p], "window {p:?}");
+            let direct = Context::new(runs[p.0].as_slice(), c, 50).at(p.1);
+            assert_eq!(f, direct.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+        }
+    }
 
     fn dot(a: &[f64], b: &[f64]) -> f64 {
         a.iter().zip(b).map(|(x, y)| x * y).sum()

@@ -1,7 +1,7 @@
 //! Evaluation of a trained model on a data set's test windows (or on all of it): metrics and
 //! the predicted force beside the true one.
 
-use super::calibration::Context;
+use super::calibration::WindowContexts;
 use super::metrics::{Metrics, metrics};
 use super::model::Model;
 use super::windows::prepare;
@@ -152,19 +152,19 @@ pub fn evaluate(model: &mut Model, ds: &DataSet, part: EvalPart) -> Result<Evalu
         let o = prep.test.outputs;
         let c = prep.test.channels;
         let len = x.len() / prep.test.len().max(1);
-        let mut context: Option<(usize, Option<Context>)> = None;
-        (0..prep.test.len())
+        let test = &prep.test;
+        let place = |i: usize| (test.windows[i].run as usize, test.last_row(i));
+        let inputs = |r: usize| test.inputs()[r].as_slice();
+        let mut contexts = (cal.reads_context())
+            .then(|| WindowContexts::new(test.len(), place, inputs, c, cal.context_rows));
+        (0..test.len())
             .map(|i| {
-                let (run, row) = (prep.test.windows[i].run as usize, prep.test.last_row(i));
-                if context.as_ref().is_none_or(|(r, _)| *r != run) {
-                    context = Some((run, cal.context(&prep.test.inputs()[run], c)));
-                }
-                let ctx = context.as_ref().and_then(|(_, x)| x.as_ref());
-                let level = cal.difficulty_of(
+                let ctx = contexts.as_mut().map(|w| w.at(i, place(i), inputs));
+                let level = cal.difficulty_with(
                     &x[i * len..(i + 1) * len],
                     c,
                     &p[i * o..(i + 1) * o],
-                    ctx.map(|x| (x, row)),
+                    ctx.as_deref(),
                 );
                 (0..o)
                     .map(|k| {

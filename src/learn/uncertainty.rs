@@ -10,6 +10,7 @@
 //! scores: marginal coverage of at least `c` on data exchangeable with the validation runs.
 
 pub use super::calibration::{CONTEXT_ROWS, Calibration, Context, Features, OOD_MARGIN, Score};
+use super::difficulty::WindowContexts;
 use super::model::Model;
 use super::train::{Progress, TrainOptions, train};
 use super::windows::{DataSpec, prepare};
@@ -41,8 +42,10 @@ pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Resu
     let (mut xb, mut yb) = (Vec::new(), Vec::new());
     let c = val.channels;
     let mut features = Vec::new();
-    // Each run's context, built when its first window comes (windows are in run order).
-    let mut context: Option<(usize, Context)> = None;
+    // Each run's context, built once (a shuffled split's windows come in no run order).
+    let place = |i: usize| (val.windows[i].run as usize, val.last_row(i));
+    let inputs = |r: usize| val.inputs()[r].as_slice();
+    let mut contexts = WindowContexts::new(val.len(), place, inputs, c, CONTEXT_ROWS);
     let mut runs_of: Vec<u32> = Vec::new();
     let idx: Vec<usize> = (0..val.len()).collect();
     for chunk in idx.chunks(BATCH) {
@@ -50,15 +53,8 @@ pub fn calibrate_with(model: &mut Model, ds: &DataSet, difficulty: bool) -> Resu
         let len = xb.len() / chunk.len().max(1);
         let (m, s) = model.predict_spread(&xb, chunk.len());
         for ((w, p), &i) in xb.chunks(len.max(1)).zip(m.chunks(o)).zip(chunk) {
-            let (run, last) = (val.windows[i].run as usize, val.last_row(i));
-            runs_of.push(run as u32);
-            if context.as_ref().is_none_or(|(r, _)| *r != run) {
-                context = Some((run, Context::new(&val.inputs()[run], c, CONTEXT_ROWS)));
-            }
-            let ctx = context
-                .as_ref()
-                .map(|(_, x)| x.at(last))
-                .unwrap_or_default();
+            runs_of.push(place(i).0 as u32);
+            let ctx = contexts.at(i, place(i), inputs);
             features.extend(super::calibration::features(w, c, p, &ctx));
         }
         y.extend_from_slice(&yb);
