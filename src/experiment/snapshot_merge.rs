@@ -178,18 +178,33 @@ pub fn merge(old: &str, new: &str) -> String {
         }
         out.push('\n');
     }
+    // Each replaced part's new rows where its old rows stood (the others in their order);
+    // a part the old snapshot had no row of, at the end.
     let headline_rows = {
-        let mut rows = o.rows(HEADLINE);
-        let new_rows = n.rows(HEADLINE);
-        let of_new = |r: &String| {
+        let part_of = |r: &String| {
             let what = first_cell(r).unwrap_or_default();
             (ROW_PARTS.iter())
-                .any(|(pre, part)| what.starts_with(pre) && parts.iter().any(|p| p == part))
+                .find(|(pre, part)| what.starts_with(pre) && parts.iter().any(|p| p == part))
+                .map(|(_, part)| *part)
         };
-        let at = rows.iter().position(of_new).unwrap_or(rows.len());
-        rows.retain(|r| !of_new(r));
-        let at = at.min(rows.len());
-        rows.splice(at..at, new_rows);
+        let new_rows = n.rows(HEADLINE);
+        let mut rows = Vec::new();
+        let mut placed: Vec<&str> = Vec::new();
+        for r in o.rows(HEADLINE) {
+            match part_of(&r) {
+                None => rows.push(r),
+                Some(p) if !placed.contains(&p) => {
+                    placed.push(p);
+                    rows.extend(new_rows.iter().filter(|x| part_of(x) == Some(p)).cloned());
+                }
+                Some(_) => {}
+            }
+        }
+        rows.extend(
+            (new_rows.iter())
+                .filter(|x| part_of(x).is_none_or(|p| !placed.contains(&p)))
+                .cloned(),
+        );
         rows
     };
     for (title, body) in &o.sections {
@@ -460,6 +475,51 @@ mod tests {
         let m = merge(&m, &both);
         assert!(
             m.contains("| the parts above, added |  | 8.0 min | 14.4 min | 1.80 |"),
+            "{m}"
+        );
+    }
+
+    /// Two parts run again with another part's rows between theirs: each part's new rows
+    /// stand where its old ones stood, and the rows between stay between.
+    #[test]
+    fn merged_rows_keep_the_order_of_the_parts() {
+        let old = snapshot(
+            "- **Run:** finished {OLD} (UTC), railforce 0.1.0, commit `aaaa`, 3.0 min wall time in all.",
+            &[
+                "| All conditions, x | 0.9 |",
+                "| Selected on-board sensors, s | 0.8 |",
+                "| The CNN-BiLSTM split by blocks | 0.7 |",
+                "| One condition (c), cnn | 0.6 |",
+            ],
+            &[
+                "| generalization | aaaa | 1.0 min |",
+                "| sensors | aaaa | 1.0 min |",
+                "| protocols | aaaa | 1.0 min |",
+            ],
+            &[],
+        );
+        let new = snapshot(
+            "- **Run:** finished {NEW} (UTC), railforce 0.1.0, commit `cccc`, 2.0 min wall time in all.",
+            &[
+                "| All conditions, y | 0.91 |",
+                "| The CNN-BiLSTM split by blocks | 0.71 |",
+            ],
+            &[
+                "| generalization | cccc | 1.0 min |",
+                "| protocols | cccc | 1.0 min |",
+            ],
+            &[],
+        );
+        let m = merge(&old, &new);
+        let at = |t: &str| m.find(t).unwrap_or_else(|| panic!("{t} missing: {m}"));
+        assert!(
+            at("All conditions, y") < at("Selected on-board sensors, s")
+                && at("Selected on-board sensors, s") < at("split by blocks | 0.71")
+                && at("split by blocks | 0.71") < at("One condition (c)"),
+            "{m}"
+        );
+        assert!(
+            !m.contains("All conditions, x") && !m.contains("| 0.7 |"),
             "{m}"
         );
     }
