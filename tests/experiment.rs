@@ -140,15 +140,12 @@ fn every_experiment_runs_end_to_end() {
     assert_eq!(meta["window"], 12);
     assert_eq!(meta["label_at"], "Centre");
     assert_eq!(meta["noise"]["reference"], "std");
-    // CPU time: positive, and no more than every core busy for the whole wall time.
-    let (wall, cpu) = (
-        meta["wall_seconds"].as_f64().unwrap(),
-        meta["cpu_seconds"].as_f64().unwrap(),
-    );
-    let cores = meta["cores"].as_f64().unwrap();
+    // CPU time: the process's, so here it counts the other tests' threads too (no bound
+    // from this run's wall time holds); it grew while the parts trained.
+    let cpu = meta["cpu_seconds"].as_f64().unwrap();
     assert!(
-        cpu > 0.0 && cpu <= wall * cores * 1.05 + 0.5,
-        "{cpu} s CPU in {wall} s on {cores}"
+        cpu > 0.0 && meta["cores"].as_u64().unwrap() >= 1,
+        "{cpu} s CPU"
     );
     assert!(meta["machine"].as_str().unwrap().ends_with(" cores"));
     let snapshot = std::fs::read_to_string(out.join("results.md")).unwrap();
