@@ -140,22 +140,32 @@ def test_assess_and_contact(demo_data):
 
 def test_threads_running_two_simulations_at_once_finish_faster_than_one_after_the_other():
     def one():
-        railforce.simulate(track="tangent", duration_s=4.0, settle_s=0.5, seed=1)
+        railforce.simulate(track="tangent", duration_s=8.0, settle_s=0.5, seed=1)
+
+    def two_in_threads():
+        threads = [threading.Thread(target=one) for _ in range(2)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+
+    def timed(f):
+        t0 = time.perf_counter()
+        f()
+        return time.perf_counter() - t0
 
     one()  # warm the contact table and the built-in files
-    t0 = time.perf_counter()
-    one()
-    one()
-    serial = time.perf_counter() - t0
-    threads = [threading.Thread(target=one) for _ in range(2)]
-    t0 = time.perf_counter()
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    parallel = time.perf_counter() - t0
-    # Two cores and the interpreter released: well under the serial time.
-    assert parallel < 0.8 * serial, (parallel, serial)
+    # With the interpreter held, two threads take at least the serial time in every round. With
+    # it released, two cores finish near half of it; a shared CI machine steals cores now and
+    # then (one round measured 0.81 of the serial time), so the best of five rounds decides.
+    ratios = []
+    for _ in range(5):
+        serial = timed(lambda: (one(), one()))
+        parallel = timed(two_in_threads)
+        ratios.append(parallel / serial)
+        if ratios[-1] < 0.8:
+            break
+    assert min(ratios) < 0.8, ratios
 
 
 def test_simulate_on_sleepers_matches_the_cli(cli, tmp_path):
