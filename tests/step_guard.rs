@@ -85,7 +85,7 @@ fn the_explicit_step_is_held_shorter() {
 /// four bisections), with the margins physics.md §6 quotes: 0.895 / 0.689 / 0.531 / 0.254 ms
 /// against 5/6, 0.5, 0.2 and 0.2 ms.
 #[test]
-#[ignore]
+#[ignore = "release: four bisections of simulated steps per integrator"]
 fn every_integrators_own_step_is_held() {
     let vehicle = Vehicle::load(&root().join("vehicles/c80.toml")).unwrap();
     let track = Track::load(&root().join("tracks/tangent.toml")).unwrap();
@@ -132,7 +132,7 @@ fn the_guard_leaves_the_run_as_it_was() {
 /// chattered in every screening run) are refused before they run, and the guard's longest step
 /// for them falls by about √1.2 (release: two bisections).
 #[test]
-#[ignore]
+#[ignore = "release: two bisections of simulated steps per pad stiffness"]
 fn the_pads_bound_the_default_step() {
     use railforce::vehicle::elements::Element;
     let track = Track::load(&root().join("tracks/tangent.toml")).unwrap();

@@ -5,7 +5,6 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use railforce::experiment::{self, ExperimentOptions, Which};
 use railforce::features::Split;
-use railforce::learn::model::ModelKind;
 use railforce::learn::train::TrainOptions;
 use railforce::sensors::SnrReference;
 use std::path::PathBuf;
@@ -233,26 +232,6 @@ pub struct DemoArgs {
     plan: PathBuf,
 }
 
-/// The demo's settings: three short runs, a CNN-BiLSTM and GBDT, two SNRs.
-pub fn demo_options(plan: PathBuf, out: PathBuf) -> ExperimentOptions {
-    ExperimentOptions {
-        models: vec![ModelKind::CnnBiLstm, ModelKind::Gbdt],
-        robustness_models: vec![ModelKind::Gbdt, ModelKind::CnnBiLstm],
-        snrs: vec![20.0, 1.0],
-        loco: vec!["curve_r400_v60".into()],
-        train: TrainOptions {
-            epochs: 15,
-            patience: 5,
-            windows_per_epoch: Some(10_000),
-            val_windows: Some(8_000),
-            ..TrainOptions::default()
-        },
-        condition_windows_per_epoch: 8_000,
-        seed_spread: false,
-        ..ExperimentOptions::full(plan, out)
-    }
-}
-
 pub fn demo(args: DemoArgs) -> Result<()> {
     if cfg!(debug_assertions) {
         eprintln!("warning: debug build; `cargo run --release -- demo` is many times faster");
@@ -260,7 +239,7 @@ pub fn demo(args: DemoArgs) -> Result<()> {
     eprintln!(
         "railforce demo: simulate 3 short conditions, train a CNN-BiLSTM and GBDT, sweep 2 SNRs, write the report"
     );
-    let opts = demo_options(super::builtin::resolve(&args.plan)?, args.out.clone());
+    let opts = ExperimentOptions::demo(super::builtin::resolve(&args.plan)?, args.out.clone());
     run_with(&[Which::Paper], &opts)?;
     super::view::write_demo_view(&args.out)?;
     let index = experiment::write_report(&args.out)?;

@@ -31,7 +31,8 @@ pub use track_spring::TrackSpring;
 pub use wedge_damper::{WedgeDamper, WedgeStatics, slider};
 
 /// Internal state of an element that has one (the friction sliders of wedges, centre plates and
-/// side bearers), zero at the static position; the simulation keeps one per element.
+/// side bearers, the shear pads' rubber branches, the nests' seated inner coils), zero at the
+/// static position; the simulation keeps one per element.
 pub type Memory = [f64; MEMORY];
 
 /// Length of an element's [`Memory`]: the shear pad's rubber holds three Maxwell branches on
