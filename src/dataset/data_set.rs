@@ -220,13 +220,24 @@ impl DataSet {
         for r in &m.runs {
             let file = dir.join(&r.file);
             let cols = read_table(&file)?;
+            // A NaN or infinity in a run would reach training, calibration and every metric
+            // unnoticed: refused here, by column and row.
+            for (name, v) in &cols {
+                if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(Error::config(
+                        &file,
+                        format!("{name}[{i}]"),
+                        format!("{} is not a finite number", v[i]),
+                    ));
+                }
+            }
             let these: Vec<String> = cols.iter().map(|(n, _)| n.clone()).collect();
             match &names {
                 None => names = Some(these),
                 Some(n) if *n != these => {
                     return Err(Error::Parse {
                         file,
-                        message: "its channels differ from the first run's".into(),
+                        message: channels_differ(n, &these),
                     });
                 }
                 _ => {}
@@ -261,5 +272,29 @@ impl DataSet {
                     .join(", ")
             ))
         })
+    }
+}
+
+/// Why a run's channels differ from the first run's: the first channel one has and the other
+/// lacks, or the first place their order differs.
+fn channels_differ(first: &[String], these: &[String]) -> String {
+    if let Some(c) = first.iter().find(|c| !these.contains(c)) {
+        return format!("its channels differ from the first run's: it lacks '{c}'");
+    }
+    if let Some(c) = these.iter().find(|c| !first.contains(c)) {
+        return format!(
+            "its channels differ from the first run's: it has '{c}', which the first lacks"
+        );
+    }
+    match first.iter().zip(these).position(|(a, b)| a != b) {
+        Some(i) => format!(
+            "its channels differ from the first run's: column {i} is '{}', the first run's '{}'",
+            these[i], first[i]
+        ),
+        None => format!(
+            "its channels differ from the first run's: {} columns against {} (a name repeated)",
+            these.len(),
+            first.len()
+        ),
     }
 }

@@ -78,6 +78,7 @@ impl CoverageRow {
                 let _ = writeln!(csv, "{},{n},{c:.4},{se:.4},{w:.3}", r.condition);
             }
         }
+        crate::io::check_csv_finite(&csv, path)?;
         crate::io::write_atomic(path, |w| w.write_all(csv.as_bytes()))
     }
 
@@ -327,6 +328,7 @@ impl Evaluation {
                 );
             }
         }
+        crate::io::check_csv_finite(&s, path)?;
         crate::io::write_atomic(path, |w| w.write_all(s.as_bytes()))
     }
 
@@ -344,6 +346,7 @@ impl Evaluation {
             }
             s.push('\n');
         }
+        crate::io::check_csv_finite(&s, path)?;
         crate::io::write_atomic(path, |w| w.write_all(s.as_bytes()))
     }
 }

@@ -270,6 +270,18 @@ impl Model {
         }
         meta.input_stats.check(&path, "input_stats")?;
         meta.target_stats.check(&path, "target_stats")?;
+        for (field, names) in [
+            ("data.channels", &meta.data.channels),
+            ("data.targets", &meta.data.targets),
+        ] {
+            if let Some(i) = (1..names.len()).find(|&i| names[..i].contains(&names[i])) {
+                return Err(Error::config(
+                    &path,
+                    format!("{field}[{i}]"),
+                    format!("\"{}\" is named twice", names[i]),
+                ));
+            }
+        }
         let engine = read_engine(dir, &path, &meta, "")?;
         let members = (2..=meta.members)
             .map(|k| read_engine(dir, &path, &meta, &format!("_member{k}")))
@@ -302,6 +314,27 @@ fn read_engine(dir: &Path, path: &Path, meta: &ModelMeta, suffix: &str) -> Resul
                     format!("{v} is outside 1..={max}"),
                 ));
             }
+        }
+        let least = config.architecture.min_window();
+        if config.window < least {
+            return Err(Error::config(
+                path,
+                "net.window",
+                format!(
+                    "{} steps: a {} reads at least {least}",
+                    config.window,
+                    config.architecture.name()
+                ),
+            ));
+        }
+        if let Some(c) = config.quantiles
+            && !(c > 0.0 && c < 1.0)
+        {
+            return Err(Error::config(
+                path,
+                "net.quantiles",
+                format!("{c} is not a coverage in (0, 1)"),
+            ));
         }
         let mut net = Network::new(config);
         if meta.slots.as_ref() != Some(&net.params.slots) {

@@ -40,6 +40,15 @@ impl Architecture {
             Architecture::Gru => "gru",
         }
     }
+
+    /// The shortest window the network reads, steps: the convolutional stem's pool joins
+    /// neighbouring steps, so it needs two.
+    pub fn min_window(self) -> usize {
+        match self {
+            Architecture::CnnBiLstm | Architecture::Cnn => 2,
+            Architecture::BiLstm | Architecture::Gru => 1,
+        }
+    }
 }
 
 /// Shape of a network.

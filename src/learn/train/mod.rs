@@ -121,6 +121,21 @@ pub fn train(
             "batch and epochs must be ≥ 1, lr > 0 and 0 ≤ dropout < 1".into(),
         ));
     }
+    if opts.val_windows == Some(0) || opts.windows_per_epoch == Some(0) {
+        return Err(Error::Domain(
+            "validation windows and training windows per epoch must be ≥ 1 when given".into(),
+        ));
+    }
+    if let Some(a) = kind.architecture()
+        && spec.window < a.min_window()
+    {
+        return Err(Error::Domain(format!(
+            "a window of {} step(s) is too short for a {}: its convolutional stem reads at least {}",
+            spec.window,
+            a.name(),
+            a.min_window()
+        )));
+    }
     let t0 = Instant::now();
     let mut prep = prepare(ds, spec, None)?;
     if let Some(cap) = opts.val_windows {
