@@ -654,3 +654,44 @@ fn conditions_draw_their_own_realisation() {
         "each condition its own noise: correlation {corr:.3}"
     );
 }
+
+/// Tables written by NumPy and pyarrow (tests/fixtures/foreign/README.md) are read as users
+/// write them: ZIP64 and deflated NPZ entries, integer, boolean and big-endian columns, and
+/// Parquet with each common codec; a 2-D or a text array is refused naming its entry.
+#[test]
+fn foreign_files_are_read() {
+    let dir = root().join("tests/fixtures/foreign");
+    let want: [(&str, [f64; 4]); 3] = [
+        ("a", [0.5, -1.25, 3.0, 1e6]),
+        ("b", [1.0, -2.0, 3.0, 40000.0]),
+        ("c", [0.25, 2.0, -8.0, 0.125]),
+    ];
+    for f in [
+        "numpy_savez.npz",
+        "numpy_savez_compressed.npz",
+        "pyarrow_snappy.parquet",
+        "pyarrow_zstd.parquet",
+        "pyarrow_gzip.parquet",
+        "pyarrow_lz4.parquet",
+    ] {
+        let t = dataset::read_table(&dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        for (name, values) in &want {
+            let (_, got) = t.iter().find(|(n, _)| n == name).expect(name);
+            assert_eq!(got, values, "{f}: {name}");
+        }
+        if f.ends_with(".npz") {
+            let (_, flag) = t.iter().find(|(n, _)| n == "flag").unwrap();
+            assert_eq!(flag, &[1.0, 0.0, 1.0, 1.0]);
+        }
+    }
+    for (f, says) in [
+        ("numpy_2d.npz", "entry 'm': shape (2, 3)"),
+        (
+            "numpy_text.npz",
+            "entry 's': data type '<U1' is not a number",
+        ),
+    ] {
+        let e = dataset::read_table(&dir.join(f)).unwrap_err().to_string();
+        assert!(e.contains(f) && e.contains(says), "{e}");
+    }
+}

@@ -11,7 +11,8 @@ use std::path::PathBuf;
 pub struct GenerateArgs {
     /// Plan file (TOML): vehicle, duration, seeds and [[condition]] tables; a built-in plan by
     /// name: `paper34` (the paper's 34 conditions), `paper34_varied` (the same with a fleet:
-    /// every run draws its own wagon and track from the plan's `[vary]`) or `demo`.
+    /// every run draws its own wagon and track from the plan's `[vary]`) or `demo`. Required
+    /// unless --merge is given.
     #[arg(long, required_unless_present = "merge")]
     plan: Option<PathBuf>,
     /// Output folder (one file per run plus manifest.json).

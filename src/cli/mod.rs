@@ -228,7 +228,7 @@ enum Command {
     )]
     Export(export::ExportArgs),
     /// Built-in benchmarks with same-run references (`bench contact`, `bench simulate`,
-    /// `bench learn`).
+    /// `bench learn`, `bench step`).
     Bench(bench::BenchArgs),
     /// Write the built-in vehicles, tracks and plans (the C80 loaded and empty, the paper's 34
     /// conditions, the demo plan) into DIR to edit them.

@@ -17,8 +17,9 @@ pub struct SensitivityArgs {
     /// 80 km/h, R 400 m at 60 km/h and the 20 ‰ grade in its train, 30 s each, one seed).
     #[arg(long, default_value = "tracks/sensitivity.plan.toml")]
     plan: PathBuf,
-    /// `morris` (screening: every estimate, r·(k + 1) runs per condition) or `sobol` (first
-    /// and total indices of a few estimates, N·(k + 2) runs per condition).
+    /// `morris` (screening: every estimate, r·(k + 1) + 1 runs per condition, the nominal one
+    /// included) or `sobol` (first and total indices of a few estimates, N·(k + 2) + 1 runs per
+    /// condition, the nominal one included).
     #[arg(long, default_value = "morris", value_parser = ["morris", "sobol"])]
     method: String,
     /// Morris trajectories (r).

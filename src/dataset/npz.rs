@@ -1,32 +1,12 @@
-//! NPZ writer: a ZIP archive (stored, no compression) of one `.npy` array per channel, as
-//! `numpy.load` reads it (`np.load("run.npz")["w1l_force_z"]`). Fixed timestamps, so the same
-//! data give the same bytes.
+//! NPZ files: the writer makes a ZIP archive (stored, no compression) of one `.npy` array per
+//! channel, as `numpy.load` reads it (`np.load("run.npz")["w1l_force_z"]`), with fixed
+//! timestamps, so the same data give the same bytes; the reader takes NumPy's own archives too.
 
 use std::io::{self, Write};
 
 /// CRC-32 (IEEE 802.3, as ZIP uses).
 fn crc32(data: &[u8]) -> u32 {
-    static TABLE: std::sync::OnceLock<[u32; 256]> = std::sync::OnceLock::new();
-    let table = TABLE.get_or_init(|| {
-        let mut t = [0u32; 256];
-        for (i, e) in t.iter_mut().enumerate() {
-            let mut c = i as u32;
-            for _ in 0..8 {
-                c = if c & 1 != 0 {
-                    0xEDB8_8320 ^ (c >> 1)
-                } else {
-                    c >> 1
-                };
-            }
-            *e = c;
-        }
-        t
-    });
-    let mut c = 0xFFFF_FFFFu32;
-    for &b in data {
-        c = table[((c ^ u32::from(b)) & 0xFF) as usize] ^ (c >> 8);
-    }
-    c ^ 0xFFFF_FFFF
+    crc32fast::hash(data)
 }
 
 /// A 1-D little-endian float64 (or float32) `.npy` file.
@@ -127,53 +107,116 @@ pub fn write_npz(w: &mut dyn Write, columns: &[(&str, &[f64])], float32: bool) -
     w.write_all(&end)
 }
 
-/// Reads back an NPZ written by [`write_npz`] (stored entries only): `(name, values)`.
+/// Reads an NPZ archive as `numpy.savez` or `savez_compressed` writes it (stored or deflated
+/// entries, ZIP64 included; the ZIP layer is the `zip` crate's) or [`write_npz`] does:
+/// `(name, values)` in the archive's order. Each entry must be a one-dimensional array of
+/// floats, integers or booleans (either byte order); an error names the entry.
 pub fn read_npz(bytes: &[u8]) -> io::Result<Vec<(String, Vec<f64>)>> {
-    let bad = |m: &str| io::Error::new(io::ErrorKind::InvalidData, m.to_string());
-    let mut out = Vec::new();
-    let mut p = 0usize;
-    let u16_at = |b: &[u8], i: usize| u16::from_le_bytes([b[i], b[i + 1]]) as usize;
-    let u32_at =
-        |b: &[u8], i: usize| u32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]) as usize;
-    while p + 30 <= bytes.len() && u32_at(bytes, p) == 0x0403_4b50 {
-        let size = u32_at(bytes, p + 18);
-        let nlen = u16_at(bytes, p + 26);
-        let xlen = u16_at(bytes, p + 28);
-        let name_start = p + 30;
-        let data_start = name_start + nlen + xlen;
-        let data = bytes
-            .get(data_start..data_start + size)
-            .ok_or_else(|| bad("truncated entry"))?;
-        let name = String::from_utf8_lossy(&bytes[name_start..name_start + nlen])
-            .trim_end_matches(".npy")
-            .to_string();
-        if !data.starts_with(b"\x93NUMPY") {
-            return Err(bad("entry is not a .npy array"));
-        }
-        if data.len() < 10 {
-            return Err(bad("truncated .npy header"));
-        }
-        let hlen = u16_at(data, 8);
-        let header = data
-            .get(10..10 + hlen)
-            .ok_or_else(|| bad("truncated .npy header"))?;
-        let header = String::from_utf8_lossy(header);
-        let body = &data[10 + hlen..];
-        let values = if header.contains("'<f4'") {
-            body.chunks_exact(4)
-                .map(|c| f64::from(f32::from_le_bytes(c.try_into().expect("4 bytes"))))
-                .collect()
-        } else if header.contains("'<f8'") {
-            body.chunks_exact(8)
-                .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-                .collect()
-        } else {
-            return Err(bad("entry is neither float64 nor float32"));
-        };
+    let bad = |m: String| io::Error::new(io::ErrorKind::InvalidData, m);
+    let mut zip = zip::ZipArchive::new(io::Cursor::new(bytes))
+        .map_err(|e| bad(format!("not a readable NPZ (ZIP) archive: {e}")))?;
+    let mut out = Vec::with_capacity(zip.len());
+    let mut data = Vec::new();
+    for i in 0..zip.len() {
+        let mut entry = zip
+            .by_index(i)
+            .map_err(|e| bad(format!("entry {i}: {e}")))?;
+        let name = entry.name().trim_end_matches(".npy").to_string();
+        data.clear();
+        io::Read::read_to_end(&mut entry, &mut data)
+            .map_err(|e| bad(format!("entry '{name}': {e}")))?;
+        let values = parse_npy(&data).map_err(|m| bad(format!("entry '{name}': {m}")))?;
         out.push((name, values));
-        p = data_start + size;
     }
     Ok(out)
+}
+
+/// The values of a one-dimensional `.npy` array (format versions 1–3).
+fn parse_npy(data: &[u8]) -> Result<Vec<f64>, String> {
+    if !data.starts_with(b"\x93NUMPY") || data.len() < 10 {
+        return Err("not a .npy array".into());
+    }
+    let (hlen, start) = match data[6] {
+        1 => (u16::from_le_bytes([data[8], data[9]]) as usize, 10),
+        2 | 3 if data.len() >= 12 => (
+            u32::from_le_bytes([data[8], data[9], data[10], data[11]]) as usize,
+            12,
+        ),
+        v => return Err(format!(".npy format version {v} is not one of 1, 2, 3")),
+    };
+    let header = data
+        .get(start..start + hlen)
+        .ok_or("truncated .npy header")?;
+    let header = String::from_utf8_lossy(header);
+    let field = |key: &str| -> Option<String> {
+        let at = header.find(&format!("'{key}'"))? + key.len() + 2;
+        let rest = header[at..].trim_start().strip_prefix(':')?.trim_start();
+        let end = if rest.starts_with('(') {
+            rest.find(')')? + 1
+        } else {
+            rest.find([',', '}'])?
+        };
+        Some(rest[..end].trim().to_string())
+    };
+    let descr = field("descr").ok_or("the .npy header has no 'descr'")?;
+    let descr = descr.trim_matches(['\'', '"']);
+    let shape = field("shape").ok_or("the .npy header has no 'shape'")?;
+    let dims: Vec<&str> = shape
+        .trim_matches(['(', ')'])
+        .split(',')
+        .map(str::trim)
+        .filter(|d| !d.is_empty())
+        .collect();
+    let n: usize = match dims.as_slice() {
+        [n] | [n, "1"] | ["1", n] => n.parse().map_err(|_| format!("shape {shape}"))?,
+        _ => return Err(format!("shape {shape}: a column needs one dimension")),
+    };
+    let body = &data[start + hlen..];
+    let (order, kind) = descr.split_at(1.min(descr.len()));
+    let big = match order {
+        "<" | "|" | "=" => false,
+        ">" => true,
+        _ => return Err(format!("data type '{descr}' is not understood")),
+    };
+    macro_rules! read {
+        ($t:ty) => {{
+            const W: usize = std::mem::size_of::<$t>();
+            if body.len() < n * W {
+                return Err(format!(
+                    "truncated: {} bytes for {n} values of '{descr}'",
+                    body.len()
+                ));
+            }
+            body[..n * W]
+                .chunks_exact(W)
+                .map(|c| {
+                    let b: [u8; W] = c.try_into().expect("width");
+                    (if big {
+                        <$t>::from_be_bytes(b)
+                    } else {
+                        <$t>::from_le_bytes(b)
+                    }) as f64
+                })
+                .collect()
+        }};
+    }
+    Ok(match kind {
+        "f8" => read!(f64),
+        "f4" => read!(f32),
+        "i8" => read!(i64),
+        "i4" => read!(i32),
+        "i2" => read!(i16),
+        "i1" => read!(i8),
+        "u8" => read!(u64),
+        "u4" => read!(u32),
+        "u2" => read!(u16),
+        "u1" | "b1" => read!(u8),
+        _ => {
+            return Err(format!(
+                "data type '{descr}' is not a number (floats, integers or booleans)"
+            ));
+        }
+    })
 }
 
 #[cfg(test)]

@@ -60,7 +60,8 @@ pub fn write_parquet(columns: &[(&str, &[f64])], float32: bool) -> Result<Vec<u8
     Ok(buf)
 }
 
-/// Reads a Parquet file written by [`write_parquet`] back into named columns.
+/// Reads a Parquet file of numeric columns (as [`write_parquet`], pandas or polars write it, with
+/// any of the snappy, zstd, gzip or lz4 codecs) into named columns.
 pub fn read_parquet(bytes: Vec<u8>) -> Result<Vec<(String, Vec<f64>)>, ParquetError> {
     let reader = SerializedFileReader::new(bytes::Bytes::from(bytes))?;
     let schema = reader.metadata().file_metadata().schema_descr_ptr();
@@ -69,19 +70,36 @@ pub fn read_parquet(bytes: Vec<u8>) -> Result<Vec<(String, Vec<f64>)>, ParquetEr
         .iter()
         .map(|c| (c.name().to_string(), Vec::new()))
         .collect();
-    for row in reader.get_row_iter(None)? {
+    for (r, row) in reader.get_row_iter(None)?.enumerate() {
         let row = row?;
         for (k, (_, field)) in row.get_column_iter().enumerate() {
-            match field {
-                parquet::record::Field::Double(v) => cols[k].1.push(*v),
-                parquet::record::Field::Float(v) => cols[k].1.push(f64::from(*v)),
-                other => {
+            use parquet::record::Field as F;
+            let v = match field {
+                F::Double(v) => *v,
+                F::Float(v) => f64::from(*v),
+                F::Long(v) => *v as f64,
+                F::Int(v) => f64::from(*v),
+                F::Short(v) => f64::from(*v),
+                F::Byte(v) => f64::from(*v),
+                F::ULong(v) => *v as f64,
+                F::UInt(v) => f64::from(*v),
+                F::UShort(v) => f64::from(*v),
+                F::UByte(v) => f64::from(*v),
+                F::Bool(v) => f64::from(u8::from(*v)),
+                F::Null => {
                     return Err(ParquetError::General(format!(
-                        "column {} is neither DOUBLE nor FLOAT: {other:?}",
+                        "column {} is empty at row {r}",
                         cols[k].0
                     )));
                 }
-            }
+                other => {
+                    return Err(ParquetError::General(format!(
+                        "column {} holds {other:?} at row {r}, not a number",
+                        cols[k].0
+                    )));
+                }
+            };
+            cols[k].1.push(v);
         }
     }
     Ok(cols)

@@ -7,10 +7,11 @@
 //! base condition's irregularities (`Condition::realisation_of`), so a parameter's effect is
 //! not buried under a new track. The generator runs it (jobs, shards, resume), and the
 //! analysis reads the labels back:
-//! - **Morris screening** ([`morris`]) over all estimates: r·(k + 1) runs per condition,
-//!   ranked by μ*;
+//! - **Morris screening** ([`morris`]) over all estimates: r·(k + 1) design runs per condition
+//!   and the nominal one, ranked by μ*;
 //! - **Sobol indices** ([`sobol`]) for chosen parameters (the screening's top ones): N·(k + 2)
-//!   runs per condition, first and total order with bootstrap intervals.
+//!   design runs per condition and the nominal one, first and total order with bootstrap
+//!   intervals.
 //!
 //! The outputs are the labels' statistics ([`outputs`]); one nominal run per condition (the
 //! files as they are) gives their reference values.
