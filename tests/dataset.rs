@@ -108,6 +108,12 @@ fn generate_resume_shard_merge_and_formats() {
     assert_eq!(started(&ev), 0);
     assert_eq!(std::fs::read(&file).unwrap(), bytes);
     assert_eq!(dataset::data_identity(&a).unwrap(), identity);
+    // A run file cut short since is simulated again, to the same bytes.
+    std::fs::write(&file, &bytes[..bytes.len() / 2]).unwrap();
+    let (_, ev) = run_events(&plan, &opts(&a, Format::Npz, None));
+    assert_eq!(started(&ev), 1);
+    assert_eq!(std::fs::read(&file).unwrap(), bytes);
+    assert_eq!(dataset::data_identity(&a).unwrap(), identity);
 
     // Another integrator is another data set: a folder made at one is refused at another,
     // naming both (the default's step has changed, so a run's key alone cannot tell);

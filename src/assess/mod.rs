@@ -80,17 +80,32 @@ impl RunForces {
                 "{source}: no s_m column: the sliding means are over track distance (simulate, generate and identify write s_m)"
             ))
         })?;
+        if time.len() < 2 {
+            return Err(Error::Domain(format!(
+                "{source}: {} row(s): a run to assess needs at least two",
+                time.len()
+            )));
+        }
         let mut wheels = Vec::new();
         for (name, _) in cols {
             let base = name.strip_suffix("_N").unwrap_or(name);
-            let Some(wheel) = base.strip_suffix("_force_y") else {
-                continue;
+            // A wheel with one of its two forces would drop out of every index unnoticed.
+            let (wheel, other) =
+                match (base.strip_suffix("_force_y"), base.strip_suffix("_force_z")) {
+                    (Some(w), _) => (w, "force_z"),
+                    (_, Some(w)) => (w, "force_y"),
+                    _ => continue,
+                };
+            let Some(paired) = find(&format!("{wheel}_{other}")) else {
+                return Err(Error::Domain(format!(
+                    "{source}: column {name} has no {wheel}_{other} beside it: a wheel is assessed on both its forces"
+                )));
             };
-            if let (Some(y), Some(q)) = (find(base), find(&format!("{wheel}_force_z"))) {
+            if other == "force_z" {
                 wheels.push(WheelSeries {
                     wheel: wheel.to_string(),
-                    y,
-                    q,
+                    y: find(base).unwrap_or_default(),
+                    q: paired,
                 });
             }
         }
@@ -99,17 +114,19 @@ impl RunForces {
                 "{source}: no wheel with both forces (columns w1l_force_y and w1l_force_z, or with _N)"
             )));
         }
-        for (what, v) in std::iter::once(("time_s", &time))
-            .chain(std::iter::once(("s_m", &s)))
-            .chain(
-                wheels
-                    .iter()
-                    .flat_map(|w| [("force", &w.y), ("force", &w.q)]),
-            )
-        {
+        let named: Vec<(String, &Vec<f64>)> = [("time_s".to_string(), &time), ("s_m".into(), &s)]
+            .into_iter()
+            .chain(wheels.iter().flat_map(|w| {
+                [
+                    (format!("{}_force_y", w.wheel), &w.y),
+                    (format!("{}_force_z", w.wheel), &w.q),
+                ]
+            }))
+            .collect();
+        for (what, v) in named {
             if let Some(r) = v.iter().position(|x| !x.is_finite()) {
                 return Err(Error::Domain(format!(
-                    "{source}: {what} column, row {}: not a finite number",
+                    "{source}: column {what}, row {}: not a finite number",
                     r + 1
                 )));
             }

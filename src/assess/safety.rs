@@ -71,6 +71,30 @@ impl Default for Limits {
 }
 
 impl Limits {
+    /// Refuses a limit no judgement can use: a non-positive or non-finite index limit or
+    /// static wheel load (ΔQ/Q̄ would divide by it), or a negative time criterion.
+    pub fn check(&self) -> crate::error::Result<()> {
+        for (what, v) in [
+            ("the Y/Q limit", self.y_over_q),
+            ("the ΔQ/Q̄ limit", self.unloading),
+            ("the static wheel load Q̄ (kN)", self.static_wheel_load_kn),
+            ("the lateral force limit's α", self.lateral_alpha),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(crate::error::Error::Domain(format!(
+                    "{what} is {v}: give a positive number"
+                )));
+            }
+        }
+        if !(self.min_duration_s.is_finite() && self.min_duration_s >= 0.0) {
+            return Err(crate::error::Error::Domain(format!(
+                "the time criterion is {} s: give a duration ≥ 0",
+                self.min_duration_s
+            )));
+        }
+        Ok(())
+    }
+
     /// Wheelset lateral force limit `α·(10 + P_st/3)` kN (α = 0.85 by default), `P_st` the
     /// static axle load in kN.
     pub fn lateral_kn(&self) -> f64 {

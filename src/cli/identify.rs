@@ -60,12 +60,16 @@ impl LimitArgs {
         if !(min_ms.is_finite() && min_ms >= 0.0) {
             bail!("--min-duration-ms {min_ms}: give a duration ≥ 0");
         }
-        Ok(Limits {
+        let limits = Limits {
             y_over_q: self.limit_yq.unwrap_or(base.y_over_q),
             unloading: self.limit_unloading.unwrap_or(base.unloading),
             min_duration_s: min_ms / 1000.0,
             ..base
-        })
+        };
+        limits.check().context(
+            "the limits (--limit-yq, --limit-unloading, --static-wheel-load-kn, --criteria)",
+        )?;
+        Ok(limits)
     }
 }
 
@@ -380,7 +384,9 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits, coverage: f64) -> Resu
     let mut positions = std::collections::VecDeque::with_capacity(spec.window);
     let mut st = Streamer::new(model);
     let mut values = vec![0.0; spec.channels.len()];
+    let mut read = 0usize;
     while let Some((t, s)) = rows.next_row(&mut values)? {
+        read += 1;
         if let Some(s) = s {
             positions.push_back(s);
             if positions.len() > spec.window {
@@ -400,6 +406,17 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits, coverage: f64) -> Resu
             flagged.push(e.outside.unwrap_or_default());
             w.flush()?;
         }
+    }
+    if times.is_empty() {
+        // Nothing identified: no safety verdict on no data, and no header-only file left.
+        drop(w);
+        if out.as_os_str() != "-" {
+            let _ = std::fs::remove_file(out);
+        }
+        bail!(
+            "the stream ended after {read} row(s), fewer than one window of {} steps: nothing identified",
+            spec.window
+        );
     }
     let reports = monitor.finish();
     let spans = enveloped.then(|| {

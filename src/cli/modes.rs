@@ -329,7 +329,10 @@ fn bifurcation(
                     railforce::sim::fidelity::HUNTING_AMPLITUDE * 1e3
                 ),
                 (Some(c), _, _) => format!("hunting down to {c:.0} km/h"),
-                _ => "no hunting".into(),
+                _ => match &run.derailed {
+                    Some(m) => format!("derails: {m}"),
+                    None => "no hunting".into(),
+                },
             }
         );
         json.insert(name.to_string(), serde_json::to_value(run)?);
@@ -388,7 +391,7 @@ fn pairs(
     ];
     std::fs::create_dir_all(out)?;
     let mut csv = String::from(
-        "pair,flange_back_mm,conicity_3mm,stuck_kmh,stuck_mode,stuck_hz,sliding_kmh,sliding_mode,sliding_hz,kink_kmh,kink_hz,run_down_kmh,run_down_hz,run_down_sigma_y_rms_kn,run_down_sigma_y_limit_kn\n",
+        "pair,flange_back_mm,conicity_3mm,stuck_kmh,stuck_mode,stuck_hz,sliding_kmh,sliding_mode,sliding_hz,kink_kmh,kink_hz,run_down_kmh,run_down_hz,run_down_sigma_y_rms_kn,run_down_sigma_y_limit_kn,kink_derails,run_down_derails\n",
     );
     let mut rows = Vec::new();
     let mut pts: [Vec<(f64, f64)>; 4] = Default::default();
@@ -404,6 +407,9 @@ fn pairs(
         "run-down"
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.2}"));
+    let derails = |n: &Option<railforce::sim::modes::Nonlinear>| {
+        n.as_ref().is_some_and(|n| n.derailed.is_some())
+    };
     for (name, v) in &cases {
         let t0 = std::time::Instant::now();
         let c = railforce::sim::modes::compare(v, track, speeds, true)?;
@@ -423,6 +429,7 @@ fn pairs(
                 "{k:.0} km/h {}",
                 f.map_or(String::new(), |f| format!("{f:.2} Hz"))
             ),
+            None if derails(n) => "derails".into(),
             None => "none".into(),
         };
         println!(
@@ -450,7 +457,7 @@ fn pairs(
         let nf =
             |n: &Option<railforce::sim::modes::Nonlinear>| n.as_ref().and_then(|n| n.frequency_hz);
         csv += &format!(
-            "{name},{:.1},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{name},{:.1},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             c.flange_back_m * 1e3,
             c.conicity.map_or(String::new(), |l| format!("{l:.4}")),
             opt(kmh(&c.stuck)),
@@ -465,6 +472,8 @@ fn pairs(
             opt(nf(&c.run_down)),
             opt(en(&c.run_down).map(|e| e.0)),
             opt(en(&c.run_down).map(|e| e.1)),
+            derails(&c.kink_and_coast),
+            derails(&c.run_down),
         );
         if let Some(l) = c.conicity {
             for (k, v) in [

@@ -2,7 +2,8 @@
 //! writes one file per run (CSV or NPZ) and a `manifest.json` that describes every channel and
 //! run. Interruption loses nothing: files are written atomically, the manifest after every
 //! finished run, and a rerun skips the runs the manifest lists as done with an unchanged
-//! definition. `--shard i/N` splits a plan across machines; `merge` joins shard manifests.
+//! definition and a file that still holds the bytes it hashed. `--shard i/N` splits a plan across
+//! machines; `merge` joins shard manifests.
 
 mod data_set;
 mod manifest;
@@ -367,8 +368,11 @@ pub fn generate(
         );
         let file = run.file_name(opts.format);
         let path = opts.out.join(&file);
+        // Done means listed with the same key and its file still holding the bytes the
+        // manifest hashed: a file cut short or edited since is simulated again.
         if let Some(entry) = done.iter().find(|e| e.key == key)
             && path.exists()
+            && file_hash(&path).is_ok_and(|h| h == entry.bytes_hash_fnv1a)
         {
             events(Event::Skipped(file.clone()));
             let mut m = manifest.lock().expect("manifest lock");

@@ -33,6 +33,10 @@ pub struct Nonlinear {
     /// wheelset's value and limit, kN (`None` when the run is shorter than the criterion's
     /// window).
     pub running_stability_kn: Option<(f64, f64)>,
+    /// The run derailed (a verdict of its own, as a hunting cycle that climbs the flange):
+    /// the simulation's message; the fields above are then empty.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub derailed: Option<String>,
 }
 
 impl Nonlinear {
@@ -73,6 +77,7 @@ impl Nonlinear {
             });
         Nonlinear {
             running_stability_kn,
+            derailed: None,
             critical_kmh: c.critical.map(|v| v * 3.6),
             frequency_hz: c.cycle_frequency().map(|c| c.1),
             cycle_kmh: c.cycle_frequency().map(|c| c.0 * 3.6),
@@ -162,8 +167,21 @@ pub fn nonlinear_views(vehicle: &Vehicle, track: &Track, speeds: &[f64]) -> Resu
         .unwrap_or(50.0 / 3.6)
         .max(50.0 / 3.6);
     let q0 = vehicle.static_wheel_load_kn();
+    // A derailment is this method's verdict on this pair, not a failure of the sweep.
+    let verdict = |r: Result<CriticalSpeed>| match r {
+        Ok(c) => Ok(Nonlinear::of(&c, q0)),
+        Err(crate::error::Error::Derailment(m)) => Ok(Nonlinear {
+            critical_kmh: None,
+            frequency_hz: None,
+            cycle_kmh: None,
+            blocks: Vec::new(),
+            running_stability_kn: None,
+            derailed: Some(m),
+        }),
+        Err(e) => Err(e),
+    };
     Ok([
-        Nonlinear::of(&critical_speed(vehicle, track, from, to, 2.0)?, q0),
-        Nonlinear::of(&run_down(vehicle, track, from, to, 1.5)?, q0),
+        verdict(critical_speed(vehicle, track, from, to, 2.0))?,
+        verdict(run_down(vehicle, track, from, to, 1.5))?,
     ])
 }
