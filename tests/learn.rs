@@ -640,3 +640,59 @@ fn quantile_heads_learn_where_the_noise_is_larger() {
     assert_eq!(opts.heads_for(ModelKind::Cnn, 2), None);
     assert_eq!(opts.heads_for(ModelKind::Gbdt, 1), None);
 }
+
+/// A window shorter than the convolutional stem reads is refused before training (it was an
+/// index panic), for both stemmed networks; the recurrent ones take one step. A hand-edited
+/// `model.json` with a channel named twice, a coverage outside (0, 1) or such a window is
+/// refused naming the field.
+#[test]
+fn short_windows_and_edited_model_files_are_refused() {
+    let ds = synthetic(2, 200);
+    let one = DataSpec {
+        window: 1,
+        ..spec()
+    };
+    for kind in [ModelKind::Cnn, ModelKind::CnnBiLstm] {
+        let out = tmp(&format!("short-{}", kind.name()));
+        let e = train(&ds, &one, kind, &quick(1), &out, &mut |_| {})
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(
+            e.contains("window of 1 step") && e.contains("at least 2"),
+            "{e}"
+        );
+    }
+    train(
+        &ds,
+        &one,
+        ModelKind::Gru,
+        &quick(1),
+        &tmp("short-gru"),
+        &mut |_| {},
+    )
+    .unwrap();
+
+    let out = tmp("edited");
+    train(&ds, &spec(), ModelKind::Cnn, &quick(1), &out, &mut |_| {}).unwrap();
+    let text = std::fs::read_to_string(out.join("model.json")).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for (edit, field) in [
+        ("channels", "data.channels[1]"),
+        ("quantiles", "net.quantiles"),
+        ("window", "net.window"),
+    ] {
+        let mut j = json.clone();
+        match edit {
+            "channels" => j["data"]["channels"][1] = "a".into(),
+            "quantiles" => j["net"]["quantiles"] = 1.5.into(),
+            _ => j["net"]["window"] = 1.into(),
+        }
+        std::fs::write(out.join("model.json"), j.to_string()).unwrap();
+        let e = Model::load(&out).err().expect("refused").to_string();
+        assert!(e.contains("model.json") && e.contains(field), "{edit}: {e}");
+    }
+    json["net"]["window"] = 8.into();
+    std::fs::write(out.join("model.json"), json.to_string()).unwrap();
+    Model::load(&out).unwrap();
+}

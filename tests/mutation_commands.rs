@@ -335,6 +335,84 @@ fn generate_pass(cases: usize) {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Values no judgement can use are refused, not judged: identify's non-positive limits and a
+/// stream that ends before one window (it printed "within limit" on no data); assess on a
+/// wheel with one of its two forces (it left the wheel out unnoticed).
+#[test]
+fn identify_and_assess_refuse_what_they_cannot_judge() {
+    let m = made();
+    let dir = scratch("refuse");
+    let fail = |cmd: &mut std::process::Command, says: &str| {
+        let out = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains(says), "{err}");
+    };
+    for (flag, says) in [
+        ("--static-wheel-load-kn=-100", "static wheel load"),
+        ("--limit-yq=-1", "Y/Q limit"),
+        ("--limit-unloading=0", "ΔQ/Q̄ limit"),
+    ] {
+        fail(
+            railforce(&dir)
+                .args(["identify", "--model"])
+                .arg(&m.model)
+                .arg("--input")
+                .arg(&m.run_csv)
+                .args(["--out", "o.csv", flag]),
+            says,
+        );
+        assert!(!dir.join("o.csv").exists(), "{flag}");
+    }
+    let rows = std::fs::read_to_string(&m.run_csv).unwrap();
+    let short: String = rows.lines().take(4).collect::<Vec<_>>().join("\n") + "\n";
+    let mut child = railforce(&dir)
+        .args(["identify", "--model"])
+        .arg(&m.model)
+        .args(["--input", "-", "--out", "s.csv"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    {
+        use std::io::Write;
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(short.as_bytes())
+            .unwrap();
+    }
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("stdin") && err.contains("after 3 row(s)"),
+        "{err}"
+    );
+    assert!(!dir.join("s.csv").exists());
+    // One wheel's vertical force dropped from the run: refused, naming the column.
+    let mut lines = rows.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let drop = header.iter().position(|h| *h == "w1l_force_z").unwrap();
+    let keep = |l: &str| {
+        l.split(',')
+            .enumerate()
+            .filter(|(i, _)| *i != drop)
+            .map(|(_, c)| c)
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    let cut: String = rows.lines().map(|l| keep(l) + "\n").collect();
+    std::fs::write(dir.join("cut.csv"), cut).unwrap();
+    fail(
+        railforce(&dir).args(["assess", "cut.csv", "--out", "a"]),
+        "w1l_force_y has no w1l_force_z",
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn generate_on_mutated_plans_never_panics_nor_writes_nan() {
     generate_pass(4);

@@ -414,7 +414,7 @@ fn stream(model: &mut Model, out: &Path, limits: &Limits, coverage: f64) -> Resu
             let _ = std::fs::remove_file(out);
         }
         bail!(
-            "the stream ended after {read} row(s), fewer than one window of {} steps: nothing identified",
+            "stdin: the stream ended after {read} row(s), fewer than one window of {} steps: nothing identified",
             spec.window
         );
     }
