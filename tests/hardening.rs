@@ -48,6 +48,58 @@ fn numbers_beyond_their_physical_bound_are_refused_naming_the_field() {
     }
 }
 
+/// Elements that would leave the wagon unsupported are refused by field: a shear pad with no
+/// stiffness on an axis, a side bearer's preload without a spring; a URDF's bad mass or
+/// missing inertial names its link, an empty one says so, and a missing URDF names the
+/// vehicle file's `urdf` key.
+#[test]
+fn unsupported_elements_and_bad_urdfs_are_named() {
+    let err = crate::common::load_c80_edited(|t| {
+        t.replacen(
+            "stiffness = [10.0e6, 5.0e6, 200.0e6]",
+            "stiffness = [10.0e6, 0.0, 200.0e6]",
+            1,
+        )
+    });
+    assert!(err.contains("shear_pad[0].stiffness[1]"), "{err}");
+    let err =
+        crate::common::load_c80_edited(|t| t.replacen("stiffness = 1.5e6", "stiffness = 0.0", 1));
+    assert!(
+        err.contains("stiffness") && err.contains("preload"),
+        "{err}"
+    );
+
+    let dir = std::env::temp_dir().join(format!("railforce-urdf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = std::fs::read_to_string(root().join("vehicles/c80.toml")).unwrap();
+    std::fs::write(dir.join("c80.toml"), &toml).unwrap();
+    let urdf = std::fs::read_to_string(root().join("vehicles/c80.urdf")).unwrap();
+    let load = || {
+        railforce::vehicle::Vehicle::load(&dir.join("c80.toml"))
+            .err()
+            .expect("refused")
+            .to_string()
+    };
+    let err = load();
+    assert!(err.contains("c80.toml") && err.contains("urdf"), "{err}");
+    for (text, says) in [
+        (
+            urdf.replacen("<mass value=\"650.0\"/>", "<mass value=\"abc\"/>", 1),
+            "link \"bolster1\".mass: \"abc\" is not a number",
+        ),
+        (
+            urdf.replacen("<mass value=\"650.0\"/>", "", 1),
+            "link \"bolster1\".mass: missing",
+        ),
+        (String::new(), "empty or cut short"),
+    ] {
+        std::fs::write(dir.join("c80.urdf"), text).unwrap();
+        let err = load();
+        assert!(err.contains("c80.urdf") && err.contains(says), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn a_nan_position_never_reaches_past_a_track_grid() {
     let track = railforce::track::Track::load(&root().join("tracks/curve_r400.toml")).unwrap();

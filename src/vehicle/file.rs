@@ -152,6 +152,16 @@ pub(super) fn load_edited(
     };
     let dir = path.parent().unwrap_or(Path::new("."));
     let urdf_path = dir.join(&raw.urdf);
+    if !urdf_path.is_file() {
+        return Err(Error::config(
+            path,
+            "urdf",
+            format!(
+                "{} is not there (a vehicle's URDF is found beside its TOML file)",
+                urdf_path.display()
+            ),
+        ));
+    }
     let mut bodies_read = super::urdf::read_urdf(&urdf_path)?;
     bodies(&mut bodies_read)?;
     let bodies = bodies_read;

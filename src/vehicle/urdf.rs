@@ -15,9 +15,18 @@ const MAX_OFFSET: f64 = 100.0;
 /// Reads the bodies of a URDF file: each link with an inertial (mass > 0), placed by the origin
 /// of the joint that attaches it to the root (floating joints from a massless reference link).
 pub(super) fn read_urdf(path: &Path) -> Result<Vec<Body>> {
-    let robot = urdf_rs::read_file(path).map_err(|e| Error::Parse {
-        file: path.to_path_buf(),
-        message: e.to_string(),
+    let text = crate::io::read_text(path)?;
+    let robot = urdf_rs::read_from_string(&text).map_err(|e| match locate(&text) {
+        Some((field, msg)) => Error::config(path, field, msg),
+        None => Error::Parse {
+            file: path.to_path_buf(),
+            message: match e.to_string() {
+                m if m.contains("No elements found") => {
+                    format!("{m}: the file is empty or cut short")
+                }
+                m => m,
+            },
+        },
     })?;
     let mut bodies = Vec::new();
     for link in &robot.links {
@@ -88,4 +97,48 @@ pub(super) fn read_urdf(path: &Path) -> Result<Vec<Body>> {
         });
     }
     Ok(bodies)
+}
+
+/// The link and field behind a URDF the parser refused, where a plain scan finds one: an
+/// inertial without its mass or inertia, or a number that does not parse (the parser's own
+/// message names neither).
+fn locate(text: &str) -> Option<(String, String)> {
+    let attr = |tag: &str, name: &str| -> Option<String> {
+        let at = tag.find(&format!("{name}=\""))? + name.len() + 2;
+        Some(tag[at..].split('"').next()?.to_string())
+    };
+    for block in text.split("<link").skip(1) {
+        let block = block.split("</link>").next().unwrap_or(block);
+        let name = attr(block, "name").unwrap_or_default();
+        let Some(inertial) = block.split("<inertial").nth(1) else {
+            continue;
+        };
+        let field = |f: &str| format!("link \"{name}\".{f}");
+        for (tag, attrs) in [
+            ("<mass", &["value"][..]),
+            ("<inertia", &["ixx", "ixy", "ixz", "iyy", "iyz", "izz"][..]),
+        ] {
+            let Some(t) = inertial.split(tag).nth(1) else {
+                return Some((field(&tag[1..]), "missing from the inertial".into()));
+            };
+            let t = t.split('>').next().unwrap_or(t);
+            for a in attrs {
+                match attr(t, a) {
+                    None if *tag == *"<mass" => {
+                        return Some((field("mass"), "has no value".into()));
+                    }
+                    Some(v) if v.trim().parse::<f64>().is_err() => {
+                        let f = if tag == "<mass" {
+                            "mass".into()
+                        } else {
+                            format!("inertia.{a}")
+                        };
+                        return Some((field(&f), format!("\"{v}\" is not a number")));
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+    None
 }

@@ -171,7 +171,10 @@ pub(crate) struct ShearPadFile {
 
 impl ShearPad {
     fn from_row(f: &str, e: &ShearPadFile, b: &Binder) -> Result<Self> {
-        b.non_negative(format!("{f}.stiffness"), &e.stiffness)?;
+        // A pad with no stiffness on an axis leaves the side frame free on it: no rubber pad.
+        for (k, v) in e.stiffness.iter().enumerate() {
+            b.positive(format!("{f}.stiffness[{k}]"), *v)?;
+        }
         b.non_negative(format!("{f}.damping"), &e.damping)?;
         b.non_negative(format!("{f}.width_m"), &[e.width_m])?;
         let rubber = match e.loss_factor {

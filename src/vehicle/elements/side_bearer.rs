@@ -101,6 +101,15 @@ impl SideBearer {
     fn from_row(f: &str, e: &SideBearerFile, b: &Binder) -> Result<Self> {
         b.non_negative(format!("{f}.stiffness"), &[e.stiffness])?;
         b.non_negative(format!("{f}.preload_n"), &[e.preload_n])?;
+        if e.preload_n > 0.0 && e.stiffness == 0.0 {
+            return Err(b.err(
+                format!("{f}.stiffness"),
+                format!(
+                    "0 with a preload of {} N: a preload is a spring's, give its stiffness",
+                    e.preload_n
+                ),
+            ));
+        }
         b.non_negative(format!("{f}.friction"), &[e.friction])?;
         b.positive(format!("{f}.stick_stiffness"), e.stick_stiffness)?;
         b.non_negative(format!("{f}.damping"), &[e.damping])?;
