@@ -305,9 +305,16 @@ fn channel_map_reads_a_field_recording() {
         (
             map_text.replace(
                 "[channels]\n",
-                "[channels]\nws2_acc_y = { column = \"LAT_ACC\" }\n",
+                "[channels]\nws2_acc_y = { column = \"Time\" }\n",
             ),
             "does not read this channel",
+        ),
+        (
+            map_text.replace(
+                "[channels]\n",
+                "[channels]\nws2_acc_y = { column = \"LAT_ACC\" }\n",
+            ),
+            "\"LAT_ACC\" is already channels.ws1_acc_y's",
         ),
     ] {
         std::fs::write(&map_path, &text).unwrap();

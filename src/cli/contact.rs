@@ -86,17 +86,17 @@ pub struct ContactArgs {
     #[command(flatten)]
     wheelset: WheelsetArgs,
     /// Lateral shift of the wheelset, mm (+ to the left).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = super::finite)]
     y_mm: f64,
     /// Yaw angle, mrad (+ turning left).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = super::finite)]
     yaw_mrad: f64,
     /// Vertical load per wheel, kN: the wheelset height is found at which each wheel carries it
     /// [default: the --vehicle's static wheel load, else 122.6].
     #[arg(long)]
     load_kn: Option<f64>,
     /// Wheelset roll relative to the rail plane, mrad, beyond the rigid roll at this shift.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = super::finite)]
     extra_roll_mrad: f64,
     /// Forward speed, km/h.
     #[arg(long, default_value_t = 60.0)]
@@ -215,6 +215,13 @@ pub fn run(args: ContactArgs) -> Result<()> {
     }
     let y = args.y_mm * 1e-3;
     let yaw = args.yaw_mrad * 1e-3;
+    if y.abs() > railforce::vehicle::ContactSettings::TABLE_RANGE {
+        anyhow::bail!(
+            "--y-mm {}: a shift beyond the contact table (±{:.0} mm) puts the wheel off its rail: no contact to compute",
+            args.y_mm,
+            railforce::vehicle::ContactSettings::TABLE_RANGE * 1e3
+        );
+    }
     let st = setup.solve(&state(&args, y, yaw));
     println!(
         "wheelset y {:+.2} mm, yaw {:+.2} mrad → rigid roll {:+.4} mrad (+ {:+.3} given), centre height {:.3} mm",
@@ -302,13 +309,7 @@ pub fn run(args: ContactArgs) -> Result<()> {
             );
         }
     }
-    if y.abs() > railforce::vehicle::ContactSettings::TABLE_RANGE {
-        eprintln!(
-            "warning: a shift of {:.1} mm lies beyond the contact table (±{:.0} mm): the wheel is off its rail",
-            args.y_mm,
-            railforce::vehicle::ContactSettings::TABLE_RANGE * 1e3
-        );
-    }
+
     println!(
         "approach: of the wheelset centre below its rigid height; track_y: load centre of the patch (elastic strip contact, the simulator's)"
     );

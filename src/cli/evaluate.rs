@@ -31,6 +31,10 @@ pub struct EvaluateArgs {
     /// (default: MODEL/metrics_per_condition.csv).
     #[arg(long)]
     metrics: Option<PathBuf>,
+    /// Interval coverage CSV, per condition and pooled, for a calibrated model
+    /// (default: MODEL/coverage_per_condition.csv).
+    #[arg(long)]
+    coverage: Option<PathBuf>,
 }
 
 /// Scores a model on a data set: metrics per condition, predictions, interval coverage.
@@ -113,7 +117,10 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
                 .iter()
                 .map(|t| target_name(t, &ds.labels))
                 .collect();
-            let path = args.model.join("coverage_per_condition.csv");
+            let path = args
+                .coverage
+                .clone()
+                .unwrap_or_else(|| args.model.join("coverage_per_condition.csv"));
             CoverageRow::write_csv(&rows, &names, &path)?;
             println!(
                 "intervals at {:.0} % nominal coverage: {}; per condition: {}",

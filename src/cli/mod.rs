@@ -264,6 +264,15 @@ fn init(args: InitArgs) -> anyhow::Result<()> {
 /// Parses the command line, runs the subcommand and turns errors into a message and exit 1.
 /// A library error with the flags that set what it names: `<what is wrong> (set by <flags>)`.
 /// The library says what is wrong in its own words; the command line adds where to change it.
+/// A number flag that must be finite: clap reads `nan` and `inf` as numbers.
+pub fn finite(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) => Err(format!("{v} is not a finite number")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 pub fn with_flags<T>(r: railforce::Result<T>, flags: &str) -> anyhow::Result<T> {
     r.map_err(|e| anyhow::anyhow!("{e} (set by {flags})"))
 }

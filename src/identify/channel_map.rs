@@ -115,6 +115,21 @@ impl ChannelMap {
                 ));
             }
         }
+        // Two model channels read from one column: one sensor cannot be two.
+        let mut seen: Vec<(&str, &str)> = Vec::new();
+        for (name, m) in &raw.channels {
+            if let Some((other, _)) = seen.iter().find(|(_, c)| *c == m.column) {
+                return Err(Error::config(
+                    path,
+                    format!("channels.{name}.column"),
+                    format!(
+                        "\"{}\" is already channels.{other}'s: each channel needs a column of its own",
+                        m.column
+                    ),
+                ));
+            }
+            seen.push((name, &m.column));
+        }
         if let Some(t) = &raw.time
             && t.unit
                 .as_deref()

@@ -159,6 +159,9 @@ pub struct Simulation<'a> {
     inputs: Vec<crate::contact::WheelOnRail>,
     /// Per wheel: how long Y/Q has exceeded the Nadal limit, s.
     over_nadal: Vec<f64>,
+    /// Each wheel off its rail at the last step (a run told to keep going warns once per
+    /// episode, not every step).
+    off_rail: Vec<bool>,
     /// Per wheel: the last step's wheel load and the sum of squared step-to-step changes of
     /// it since the chatter window opened (`watch`), N and N².
     chatter: Vec<(f64, f64)>,
@@ -395,6 +398,7 @@ impl<'a> Simulation<'a> {
             }),
             inputs: vec![rest; n_wheels],
             over_nadal: vec![0.0; n_wheels],
+            off_rail: vec![false; n_wheels],
             chatter: vec![(static_load, 0.0); n_wheels],
             static_load,
             hauling_integral: 0.0,

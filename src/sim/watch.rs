@@ -110,7 +110,11 @@ impl Simulation<'_> {
             let name = || wheel_name(k);
             // Climb: how far the wheel has risen on its flange (contact radius above the tape
             // circle) plus any gap; derailed at 90 % of the flange height (the tip is rounded).
-            if w.climb > self.cfg.climb_limit * flange || w.y_rel.abs() > self.cfg.lateral_limit {
+            let off =
+                w.climb > self.cfg.climb_limit * flange || w.y_rel.abs() > self.cfg.lateral_limit;
+            let first = off && !self.off_rail[k];
+            self.off_rail[k] = off;
+            if off && (first || self.cfg.stop_on_derailment) {
                 let mut msg = format!(
                     "derailment at t = {:.3} s, s = {:.1} m: wheel {} climbed {:.1} mm of its {:.1} mm flange (lateral shift {:.1} mm relative to its rail)",
                     self.time,
@@ -134,7 +138,9 @@ impl Simulation<'_> {
                 if self.cfg.stop_on_derailment {
                     return Err(Error::Derailment(msg));
                 }
-                eprintln!("warning: {msg}");
+                eprintln!(
+                    "warning: {msg}; the run goes on (warned again only after the wheel is back on its rail)"
+                );
             }
             if w.q > 1.0 && (w.y / w.q).abs() > limit {
                 self.over_nadal[k] += self.cfg.dt;
