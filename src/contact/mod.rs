@@ -3,6 +3,7 @@
 mod codec;
 mod creep;
 mod elastic;
+mod flange;
 mod geometry;
 mod hertz;
 mod jacobian;
@@ -17,6 +18,7 @@ mod wheel_rail;
 
 pub use creep::{CreepContact, CreepForce, CreepLaw, Creepage, PolachParams};
 pub use elastic::{PatchLoad, StripQuery, StripTable};
+pub use flange::{Flange, MIN_FLANGE_HEIGHT};
 pub use geometry::{ContactState, Side, WheelContact, WheelsetGeometry};
 pub use hertz::{HertzEllipse, HertzShape, Material};
 pub use jacobian::{patch_damping, patch_damping_with_spring, patch_normal, patch_stiffness};

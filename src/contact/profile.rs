@@ -366,10 +366,18 @@ pub fn rail_60kg() -> Profile {
 }
 
 /// A wheel profile by name (`s1002`) or from a file read with `opts` (see [`load`]).
+/// A file's profile must have a flange on the gauge side ([`super::Flange::check`]).
 pub fn wheel_by_name_or_file(spec: &str, opts: LoadOptions) -> Result<Profile> {
     match spec.to_ascii_lowercase().as_str() {
         "s1002" => Ok(s1002()),
-        _ => load(Path::new(spec), opts),
+        _ => {
+            let p = load(Path::new(spec), opts)?;
+            super::Flange::check(&p).map_err(|message| Error::Parse {
+                file: spec.into(),
+                message,
+            })?;
+            Ok(p)
+        }
     }
 }
 

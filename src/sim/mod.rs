@@ -403,14 +403,7 @@ impl<'a> Simulation<'a> {
             static_load,
             hauling_integral: 0.0,
             time: -cfg.settle,
-            flange_height: {
-                let w = geo.wheel();
-                let (lo, hi) = w.range();
-                (0..=2000)
-                    .map(|i| w.eval(lo + (hi - lo) * i as f64 / 2000.0).0)
-                    .fold(f64::MIN, f64::max)
-                    - w.eval(0.0).0
-            },
+            flange_height: crate::contact::Flange::of(geo.wheel()).height,
             nadal_limit: SimConfig {
                 nadal_angle: Some(cfg.nadal_angle.unwrap_or(vehicle.contact.flange_angle)),
                 ..SimConfig::default()
