@@ -201,7 +201,7 @@ fn bad_vehicle_files_name_file_and_element() {
                 |t| t.replacen("stiffness = [10.0e6,", "stiffness = [-10.0e6,", 1),
                 id,
             ),
-            "shear_pad[0].stiffness: must not be negative",
+            "shear_pad[0].stiffness[0]: must be positive",
         ),
         (
             write_vehicle("mass", id, |u| {

@@ -102,6 +102,14 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     args.vehicle = super::builtin::resolve(&args.vehicle)?;
     args.track = super::builtin::resolve(&args.track)?;
     let vehicle = Vehicle::load(&args.vehicle)?;
+    let flange = railforce::contact::Flange::of(vehicle.contact.geometry.wheel());
+    if flange.is_flangeless() {
+        eprintln!(
+            "note: the wheel profile {} has no flange (it rises {:.1} mm above its tape circle): the wheels cannot flange, and the derailment watch reads a climb of 90 % of that height (a cone for textbook checks, or a file cut short?)",
+            vehicle.contact.geometry.wheel().name,
+            flange.height * 1e3
+        );
+    }
     let mut spec = TrackSpec::load(&args.track)?;
     if let Some(m) = &args.rail_support {
         spec.set_rail_model(m)?;

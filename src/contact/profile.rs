@@ -366,7 +366,7 @@ pub fn rail_60kg() -> Profile {
 }
 
 /// A wheel profile by name (`s1002`) or from a file read with `opts` (see [`load`]).
-/// A file's profile must have a flange on the gauge side ([`super::Flange::check`]).
+/// A file's profile must rise toward the gauge side ([`super::Flange::check`]).
 pub fn wheel_by_name_or_file(spec: &str, opts: LoadOptions) -> Result<Profile> {
     match spec.to_ascii_lowercase().as_str() {
         "s1002" => Ok(s1002()),
