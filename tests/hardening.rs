@@ -76,8 +76,7 @@ fn unsupported_elements_and_bad_urdfs_are_named() {
     let urdf = std::fs::read_to_string(root().join("vehicles/c80.urdf")).unwrap();
     let load = || {
         railforce::vehicle::Vehicle::load(&dir.join("c80.toml"))
-            .err()
-            .expect("refused")
+            .expect_err("refused")
             .to_string()
     };
     let err = load();
