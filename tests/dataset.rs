@@ -701,3 +701,21 @@ fn foreign_files_are_read() {
         assert!(e.contains(f) && e.contains(says), "{e}");
     }
 }
+
+/// A CSV header that names a column twice, or a file separated by semicolons, is refused
+/// saying so (the first read as a missing channel, the second as one 6 kB column name).
+#[test]
+fn csv_headers_that_cannot_be_columns_are_refused() {
+    let p = Path::new("rec.csv");
+    let e = dataset::read_csv(b"time_s,a,b,a\n0,1,2,3\n", p)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("rec.csv") && e.contains("column a appears twice (columns 2 and 4"),
+        "{e}"
+    );
+    let e = dataset::read_csv(b"time_s;a;b\n0;1;2\n", p)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("comma-separated") && e.contains("';'"), "{e}");
+}

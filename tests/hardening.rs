@@ -347,6 +347,20 @@ fn a_weight_that_is_not_finite_is_refused_by_index() {
         err.contains("weights.bin") && err.contains("values[3]"),
         "{err}"
     );
+    // Bytes beyond the weights, and a file cut short, each told as what it is.
+    write_weights(&w, &values).unwrap();
+    let mut bytes = std::fs::read(&w).unwrap();
+    bytes.extend_from_slice(&[0; 8]);
+    std::fs::write(&w, &bytes).unwrap();
+    let err = read_weights(&w).unwrap_err().to_string();
+    assert!(err.contains("bytes beyond the weights"), "{err}");
+    bytes.truncate(bytes.len() - 22);
+    std::fs::write(&w, &bytes).unwrap();
+    let err = read_weights(&w).unwrap_err().to_string();
+    assert!(
+        err.contains("cut short") && err.contains("and a part"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

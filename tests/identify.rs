@@ -80,6 +80,16 @@ fn bad_input_gets_a_clear_error() {
     nan.columns[0].1[41] = f64::NAN;
     let e = check(&nan, &m, false).unwrap_err().to_string();
     assert!(e.contains("column a, row 42"), "{e}");
+    // A value no sensor gives (it overflowed the network into NaN, blamed on the output).
+    let mut huge = good.clone();
+    huge.columns[0].1[9] = 1e300;
+    let e = check(&huge, &m, false).unwrap_err().to_string();
+    assert!(e.contains("column a, row 10") && e.contains("standard deviations"), "{e}");
+    // Time running backwards is told as such, not as an infinite rate.
+    let mut back = good.clone();
+    back.time[51] = back.time[49];
+    let e = check(&back, &m, false).unwrap_err().to_string();
+    assert!(e.contains("time does not increase"), "{e}");
     let mut slow = good.clone();
     slow.time = (0..slow.time.len()).map(|i| i as f64 * 0.01).collect();
     let e = check(&slow, &m, false).unwrap_err().to_string();

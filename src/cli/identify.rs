@@ -128,10 +128,12 @@ pub fn run(args: IdentifyArgs) -> Result<()> {
         None => SensorTable::read(&args.input)?,
     };
     let input = check(&table, &model, args.resample).map_err(|e| {
-        if args.resample {
+        // The hint only where the rate is what is wrong.
+        let m = e.to_string();
+        if args.resample || !m.contains(" Hz without gaps") {
             anyhow::anyhow!(e)
         } else {
-            anyhow::anyhow!("{e}; --resample interpolates a record onto the model's rate")
+            anyhow::anyhow!("{m}; --resample interpolates a record onto the model's rate")
         }
     })?;
     let t0 = std::time::Instant::now();

@@ -212,6 +212,12 @@ pub fn generate(
     let manifest_file = manifest_path(opts);
     let previous = Manifest::read(&manifest_file)?;
     refuse_mixing(&manifest_file, previous.as_ref(), opts, dataset)?;
+    if opts.out.exists() && !opts.out.is_dir() {
+        return Err(Error::Domain(format!(
+            "{}: a file, not a folder: a data set is a folder of runs and its manifest (give another --out)",
+            opts.out.display()
+        )));
+    }
     std::fs::create_dir_all(&opts.out).map_err(|e| Error::io(&opts.out, e))?;
     let vehicle = Vehicle::load(&plan.vehicle)?;
     let labels = label_channels(&vehicle.label_wheel_name());

@@ -55,6 +55,20 @@ pub fn read_csv(bytes: &[u8], file: &Path) -> Result<Vec<(String, Vec<f64>)>> {
         file: file.to_path_buf(),
         message,
     };
+    if header.len() == 1 && header[0].contains([';', '\t']) {
+        return Err(parse_err(
+            "the header has no comma: railforce reads comma-separated CSV (this file looks separated by ';' or tabs)".into(),
+        ));
+    }
+    if let Some(k) = (1..header.len()).find(|&k| header[..k].contains(&header[k])) {
+        let first = header.iter().position(|h| *h == header[k]).unwrap_or(0);
+        return Err(parse_err(format!(
+            "column {} appears twice (columns {} and {} of the header)",
+            header[k],
+            first + 1,
+            k + 1
+        )));
+    }
     for (ln, line) in lines.enumerate() {
         let fields = line.split(',').count();
         if fields != header.len() {

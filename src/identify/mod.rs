@@ -148,10 +148,24 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
         )));
     }
     let mut columns: Vec<Vec<f64>> = Vec::new();
-    for name in &used {
+    let stats = &model.meta.input_stats;
+    for (k, name) in used.iter().enumerate() {
         let v = table.column(name).expect("checked above");
         if let Some(r) = v.iter().position(|x| !x.is_finite()) {
             return Err(not_finite(&table.source, name, r + 1, v[r]));
+        }
+        // A value a million standard deviations from the training data is no measurement (a
+        // unit slip or a corrupt cell), and would overflow the network into NaN.
+        if let (Some(&m), Some(&sd)) = (stats.mean.get(k), stats.std.get(k))
+            && let Some(r) = v.iter().position(|x| ((x - m) / sd).abs() > MAX_DEVIATIONS)
+        {
+            return Err(Error::Domain(format!(
+                "{}: column {name}, row {}: value {} lies {:.1e} standard deviations from what the model was trained on (mean {m:.4e}, std {sd:.4e}): a unit slip or a corrupt cell",
+                table.source,
+                r + 1,
+                v[r],
+                ((v[r] - m) / sd).abs()
+            )));
         }
         columns.push(v.to_vec());
     }
@@ -213,6 +227,11 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
     }
 }
 
+/// Farthest an input may lie from the training data's mean, in its standard deviations,
+/// before it is refused as no measurement (a choice: the training data's own extremes lie
+/// within tens).
+const MAX_DEVIATIONS: f64 = 1e6;
+
 /// A value that is not finite, named by source, column and row (from 1 after the header): the
 /// batch check's and the stream's one wording.
 fn not_finite(source: &str, column: &str, row: usize, value: f64) -> Error {
@@ -224,11 +243,13 @@ fn not_finite(source: &str, column: &str, row: usize, value: f64) -> Error {
 /// A time step other than one 200 Hz interval between `row` and the next (from 1 after the
 /// header), with `hint` appended.
 fn irregular_step(source: &str, row: usize, step: f64, hint: &str) -> Error {
-    let rate = if step > 0.0 {
-        1.0 / step
-    } else {
-        f64::INFINITY
-    };
+    if step <= 0.0 {
+        return Error::Domain(format!(
+            "{source}: time column, rows {row}–{}: time does not increase (step {step:.6} s)",
+            row + 1
+        ));
+    }
+    let rate = 1.0 / step;
     Error::Domain(format!(
         "{source}: time column, rows {row}–{}: step {step:.6} s ({rate:.1} Hz); the model needs {RATE_HZ} Hz without gaps{hint}",
         row + 1

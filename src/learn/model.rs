@@ -401,7 +401,25 @@ pub fn read_weights(path: &Path) -> Result<Vec<f32>> {
         .and_then(|b| b.checked_add(16))
         .and_then(|b| usize::try_from(b).ok());
     if expected != Some(bytes.len()) {
-        return Err(Error::config(path, "length", "truncated weight file"));
+        let held = (bytes.len() - 16) / 4;
+        return Err(Error::config(
+            path,
+            "length",
+            format!(
+                "the header counts {n} weights and the file holds {} bytes after it ({held} weights{}): {}",
+                bytes.len() - 16,
+                if (bytes.len() - 16) % 4 == 0 {
+                    ""
+                } else {
+                    " and a part"
+                },
+                if expected.is_some_and(|e| bytes.len() < e) {
+                    "cut short"
+                } else {
+                    "bytes beyond the weights"
+                }
+            ),
+        ));
     }
     Ok(bytes[16..]
         .chunks_exact(4)
