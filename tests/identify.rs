@@ -84,7 +84,10 @@ fn bad_input_gets_a_clear_error() {
     let mut huge = good.clone();
     huge.columns[0].1[9] = 1e300;
     let e = check(&huge, &m, false).unwrap_err().to_string();
-    assert!(e.contains("column a, row 10") && e.contains("standard deviations"), "{e}");
+    assert!(
+        e.contains("column a, row 10") && e.contains("standard deviations"),
+        "{e}"
+    );
     // Time running backwards is told as such, not as an infinite rate.
     let mut back = good.clone();
     back.time[51] = back.time[49];

@@ -410,6 +410,29 @@ fn identify_and_assess_refuse_what_they_cannot_judge() {
         railforce(&dir).args(["assess", "cut.csv", "--out", "a"]),
         "w1l_force_y has no w1l_force_z",
     );
+    // The run's own track, from its .meta.json; another one is warned of.
+    let out = railforce(&dir)
+        .arg("assess")
+        .arg(&m.run_csv)
+        .args(["--out", "own"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success() && err.contains("sections from") && err.contains("curve_r800.toml"),
+        "{err}"
+    );
+    let tangent = root().join("tracks/tangent.toml");
+    let out = railforce(&dir)
+        .arg("assess")
+        .arg(&m.run_csv)
+        .arg("--track")
+        .arg(&tangent)
+        .args(["--out", "other"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("was simulated on track 'curve_r800'"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use railforce::assess::{Criteria, assess_columns, spans};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct AssessArgs {
@@ -11,8 +11,8 @@ pub struct AssessArgs {
     /// (identified forces `w1l_force_y_N` with `s_m`).
     file: PathBuf,
     /// Track of the run, to assess each section (tangent, transition, curve by radius) apart
-    /// [default: the track the data set's manifest names for this run, else the whole run as
-    /// one section].
+    /// [default: the track the data set's manifest or the run's own `.meta.json` names, else
+    /// the whole run as one section]; another file than the run's is warned of.
     #[arg(long)]
     track: Option<PathBuf>,
     /// Criteria file (filters, windows, percentiles, limits, each with its source) [default:
@@ -35,13 +35,6 @@ pub struct AssessArgs {
     coverage: f64,
 }
 
-/// The track a data set's manifest records for the run file `file`, if any.
-fn track_from_manifest(file: &Path) -> Option<PathBuf> {
-    let (_, run) = railforce::dataset::run_entry(file)?;
-    let p = run.track.file;
-    p.exists().then_some(p)
-}
-
 pub fn run(args: AssessArgs) -> Result<()> {
     let criteria = match &args.criteria {
         Some(p) => Criteria::load(&super::builtin::resolve(p)?)?,
@@ -56,9 +49,25 @@ pub fn run(args: AssessArgs) -> Result<()> {
         }
     };
     let cols = railforce::dataset::read_table(&args.file)?;
+    let recorded = railforce::dataset::recorded_track(&args.file);
     let track = match &args.track {
-        Some(t) => Some(super::builtin::resolve(t)?),
-        None => track_from_manifest(&args.file),
+        Some(t) => {
+            let t = super::builtin::resolve(t)?;
+            // A track other than the run's own cuts the run into sections it never ran.
+            if let Some(r) = &recorded
+                && railforce::dataset::file_hash(&t)? != r.hash_fnv1a
+            {
+                eprintln!(
+                    "warning: {} was simulated on track '{}' ({}), and --track gives {}, another file: its sections may not be the run's",
+                    args.file.display(),
+                    r.name,
+                    r.file.display(),
+                    t.display()
+                );
+            }
+            Some(t)
+        }
+        None => recorded.map(|r| r.file).filter(|p| p.exists()),
     };
     let sections = match &track {
         Some(t) => {

@@ -130,3 +130,14 @@ pub fn write_run(path: &Path, rec: &Recording, format: Format, float32: bool) ->
         }
     }
 }
+
+/// The track a run file was simulated on, as its data set's manifest or its own
+/// `<run>.meta.json` (written by `simulate`) records it; `None` where neither does.
+pub fn recorded_track(run_file: &Path) -> Option<super::FileRef> {
+    if let Some((_, run)) = super::run_entry(run_file) {
+        return Some(run.track);
+    }
+    let meta = run_file.with_extension("meta.json");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(meta).ok()?).ok()?;
+    serde_json::from_value(v.get("track")?.clone()).ok()
+}
