@@ -136,16 +136,18 @@ fn parse_npy(data: &[u8]) -> Result<Vec<f64>, String> {
     if !data.starts_with(b"\x93NUMPY") || data.len() < 10 {
         return Err("not a .npy array".into());
     }
-    let (hlen, start) = match data[6] {
+    let (hlen, start): (usize, usize) = match data[6] {
         1 => (u16::from_le_bytes([data[8], data[9]]) as usize, 10),
         2 | 3 if data.len() >= 12 => (
             u32::from_le_bytes([data[8], data[9], data[10], data[11]]) as usize,
             12,
         ),
+        2 | 3 => return Err("truncated .npy header".into()),
         v => return Err(format!(".npy format version {v} is not one of 1, 2, 3")),
     };
-    let header = data
-        .get(start..start + hlen)
+    let header = start
+        .checked_add(hlen)
+        .and_then(|end| data.get(start..end))
         .ok_or("truncated .npy header")?;
     let header = String::from_utf8_lossy(header);
     let field = |key: &str| -> Option<String> {
@@ -172,7 +174,10 @@ fn parse_npy(data: &[u8]) -> Result<Vec<f64>, String> {
         _ => return Err(format!("shape {shape}: a column needs one dimension")),
     };
     let body = &data[start + hlen..];
-    let (order, kind) = descr.split_at(1.min(descr.len()));
+    let (order, kind) = match descr.char_indices().nth(1) {
+        Some((i, _)) => descr.split_at(i),
+        None => (descr, ""),
+    };
     let big = match order {
         "<" | "|" | "=" => false,
         ">" => true,
@@ -181,13 +186,17 @@ fn parse_npy(data: &[u8]) -> Result<Vec<f64>, String> {
     macro_rules! read {
         ($t:ty) => {{
             const W: usize = std::mem::size_of::<$t>();
-            if body.len() < n * W {
-                return Err(format!(
-                    "truncated: {} bytes for {n} values of '{descr}'",
-                    body.len()
-                ));
-            }
-            body[..n * W]
+            // n from the file: its byte count checked, never trusted to fit.
+            let need = n
+                .checked_mul(W)
+                .filter(|&b| b <= body.len())
+                .ok_or_else(|| {
+                    format!(
+                        "truncated: {} bytes for {n} values of '{descr}'",
+                        body.len()
+                    )
+                })?;
+            body[..need]
                 .chunks_exact(W)
                 .map(|c| {
                     let b: [u8; W] = c.try_into().expect("width");
@@ -222,6 +231,45 @@ fn parse_npy(data: &[u8]) -> Result<Vec<f64>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A header from a file is never trusted: a non-ASCII type, a count whose bytes overflow,
+    /// a length past the end, a version-2 header cut short: each an error, never a panic.
+    #[test]
+    fn malformed_npy_headers_are_errors() {
+        let npy_with = |header: &str, version: u8, body: &[u8]| {
+            let mut b = b"\x93NUMPY".to_vec();
+            b.extend_from_slice(&[version, 0]);
+            b.extend_from_slice(&(header.len() as u16).to_le_bytes());
+            b.extend_from_slice(header.as_bytes());
+            b.extend_from_slice(body);
+            b
+        };
+        for (header, says) in [
+            (
+                "{'descr': '\u{e9}8', 'fortran_order': False, 'shape': (1,), }",
+                "not understood",
+            ),
+            (
+                "{'descr': '<f8', 'fortran_order': False, 'shape': (2305843009213693952,), }",
+                "truncated",
+            ),
+            (
+                "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }",
+                "one dimension",
+            ),
+        ] {
+            let e = parse_npy(&npy_with(header, 1, &[0; 8])).unwrap_err();
+            assert!(e.contains(says), "{header}: {e}");
+        }
+        let mut long = npy_with("{'descr': '<f8', 'shape': (1,), }", 1, &[0; 8]);
+        long[8] = 0xFF;
+        assert!(parse_npy(&long).unwrap_err().contains("truncated"));
+        assert!(
+            parse_npy(b"\x93NUMPY\x02\x00\x01\x00")
+                .unwrap_err()
+                .contains("truncated")
+        );
+    }
 
     #[test]
     fn crc32_known_value() {

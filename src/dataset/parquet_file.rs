@@ -88,14 +88,16 @@ pub fn read_parquet(bytes: Vec<u8>) -> Result<Vec<(String, Vec<f64>)>, ParquetEr
                 F::Bool(v) => f64::from(u8::from(*v)),
                 F::Null => {
                     return Err(ParquetError::General(format!(
-                        "column {} is empty at row {r}",
-                        cols[k].0
+                        "column {} is empty at row {}",
+                        cols[k].0,
+                        r + 1
                     )));
                 }
                 other => {
                     return Err(ParquetError::General(format!(
-                        "column {} holds {other:?} at row {r}, not a number",
-                        cols[k].0
+                        "column {} holds {other:?} at row {}, not a number",
+                        cols[k].0,
+                        r + 1
                     )));
                 }
             };

@@ -52,8 +52,11 @@ pub fn check(table: &SensorTable, model: &Model, resample: bool) -> Result<Check
             return Err(not_finite(&table.source, name, r + 1, v[r]));
         }
         // A value a million standard deviations from the training data is no measurement (a
-        // unit slip or a corrupt cell), and would overflow the network into NaN.
+        // unit slip or a corrupt cell), and would overflow the network into NaN. A channel
+        // constant in training (a vehicle's mass) keeps a rounding-sized std: its scale is at
+        // least a thousandth of its mean.
         if let (Some(&m), Some(&sd)) = (stats.mean.get(k), stats.std.get(k))
+            && let sd = sd.max(1e-3 * m.abs())
             && let Some(r) = v.iter().position(|x| ((x - m) / sd).abs() > MAX_DEVIATIONS)
         {
             return Err(Error::Domain(format!(

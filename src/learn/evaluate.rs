@@ -321,10 +321,16 @@ impl Evaluation {
         let all = [("all".to_string(), self.metrics.clone())];
         for (c, ms) in per_condition.iter().chain(all.iter()) {
             for m in ms {
+                // R² is undefined where the test labels do not vary (`metrics`): an empty cell.
+                let r2 = if m.r2.is_finite() {
+                    format!("{:.6}", m.r2)
+                } else {
+                    String::new()
+                };
                 let _ = writeln!(
                     s,
-                    "{c},{},{},{:.6},{:.6},{:.6},{:.4},{:.4}",
-                    m.target, m.n, m.mse, m.r2, m.var_y, m.rmse_kn, m.mae_kn
+                    "{c},{},{},{:.6},{r2},{:.6},{:.4},{:.4}",
+                    m.target, m.n, m.mse, m.var_y, m.rmse_kn, m.mae_kn
                 );
             }
         }

@@ -413,7 +413,7 @@ pub fn read_weights(path: &Path) -> Result<Vec<f32>> {
                 } else {
                     " and a part"
                 },
-                if expected.is_some_and(|e| bytes.len() < e) {
+                if expected.is_none_or(|e| bytes.len() < e) {
                     "cut short"
                 } else {
                     "bytes beyond the weights"

@@ -103,9 +103,19 @@ pub(super) fn read_urdf(path: &Path) -> Result<Vec<Body>> {
 /// inertial without its mass or inertia, or a number that does not parse (the parser's own
 /// message names neither).
 fn locate(text: &str) -> Option<(String, String)> {
+    // `name="…"` or `name='…'`, spaces allowed around `=`.
     let attr = |tag: &str, name: &str| -> Option<String> {
-        let at = tag.find(&format!("{name}=\""))? + name.len() + 2;
-        Some(tag[at..].split('"').next()?.to_string())
+        let mut rest = tag;
+        loop {
+            let at = rest.find(name)?;
+            let after = rest[at + name.len()..].trim_start();
+            rest = &rest[at + name.len()..];
+            if let Some(v) = after.strip_prefix('=') {
+                let v = v.trim_start();
+                let q = v.chars().next().filter(|c| *c == '"' || *c == '\'')?;
+                return Some(v[1..].split(q).next()?.to_string());
+            }
+        }
     };
     for block in text.split("<link").skip(1) {
         let block = block.split("</link>").next().unwrap_or(block);
@@ -124,7 +134,7 @@ fn locate(text: &str) -> Option<(String, String)> {
             let t = t.split('>').next().unwrap_or(t);
             for a in attrs {
                 match attr(t, a) {
-                    None if *tag == *"<mass" => {
+                    None if *tag == *"<mass" && !t.contains("value") => {
                         return Some((field("mass"), "has no value".into()));
                     }
                     Some(v) if v.trim().parse::<f64>().is_err() => {
