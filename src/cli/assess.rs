@@ -49,12 +49,13 @@ pub fn run(args: AssessArgs) -> Result<()> {
         }
     };
     let cols = railforce::dataset::read_table(&args.file)?;
-    let recorded = railforce::dataset::recorded_track(&args.file);
+    let recorded = railforce::dataset::recorded_run(&args.file).track;
     let track = match &args.track {
         Some(t) => {
             let t = super::builtin::resolve(t)?;
             // A track other than the run's own cuts the run into sections it never ran.
             if let Some(r) = &recorded
+                && !r.hash_fnv1a.is_empty()
                 && railforce::dataset::file_hash(&t)? != r.hash_fnv1a
             {
                 eprintln!(

@@ -42,43 +42,6 @@ pub struct ViewArgs {
     rate_hz: f64,
 }
 
-/// What the run's metadata says: vehicle file, track file, seed and speed.
-#[derive(Default)]
-struct RunMeta {
-    vehicle: Option<PathBuf>,
-    track: Option<PathBuf>,
-    seed: Option<u64>,
-    speed_kmh: Option<f64>,
-}
-
-fn read_json(path: &Path) -> Option<serde_json::Value> {
-    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
-}
-
-/// The metadata of a run: `<stem>.meta.json` beside a simulate CSV, or its entry in the
-/// `manifest.json` of a data set.
-fn run_meta(run: &Path) -> RunMeta {
-    let stem = run.file_stem().map(|s| s.to_string_lossy().into_owned());
-    let path_of = |v: &serde_json::Value| v["file"].as_str().map(PathBuf::from);
-    if let Some(m) = stem.and_then(|s| read_json(&run.with_file_name(format!("{s}.meta.json")))) {
-        return RunMeta {
-            vehicle: path_of(&m["vehicle"]),
-            track: path_of(&m["track"]),
-            seed: m["seed"].as_u64(),
-            speed_kmh: m["speed_kmh"].as_f64(),
-        };
-    }
-    match railforce::dataset::run_entry(run) {
-        Some((m, r)) => RunMeta {
-            vehicle: Some(m.vehicle.file),
-            track: Some(r.track.file),
-            seed: Some(r.realisation_seed.unwrap_or(r.seed)),
-            speed_kmh: Some(r.speed_kmh),
-        },
-        None => RunMeta::default(),
-    }
-}
-
 /// `path` when it exists, else the built-in file of the same name in `folder`.
 fn locate(path: &Path, folder: &str) -> Result<PathBuf> {
     if path.exists() {
@@ -111,13 +74,13 @@ fn build(
     if !run.is_file() {
         bail!("{}: no such run file", run.display());
     }
-    let meta = run_meta(run);
+    let meta = railforce::dataset::recorded_run(run);
     let vehicle_path = match (src.vehicle, &meta.vehicle) {
         (Some(p), _) => super::builtin::resolve(p)?,
         (None, Some(p)) => locate(p, "vehicles")?,
         (None, None) => super::builtin::resolve(Path::new("vehicles/c80.toml"))?,
     };
-    let track_path = match (src.track, &meta.track) {
+    let track_path = match (src.track, meta.track.as_ref().map(|t| &t.file)) {
         (Some(p), _) => super::builtin::resolve(p)?,
         (None, Some(p)) => locate(p, "tracks")?,
         (None, None) => bail!(

@@ -18,7 +18,7 @@ pub use manifest::{
     data_identity, file_hash, fnv1a, manifest_path, merge, parse_shard, run_entry,
 };
 use manifest::{refuse_mixing, run_key};
-pub use run_file::{CHANNEL_KINDS, keeps_f64, recorded_track, write_run};
+pub use run_file::{CHANNEL_KINDS, RecordedRun, keeps_f64, recorded_run, write_run};
 use run_file::{add_noise, keep_channels};
 pub use table::{not_a_number, read_csv, read_table, row_length};
 

@@ -5,7 +5,7 @@ use super::{Format, npz, parquet_file};
 use crate::error::{Error, Result};
 use crate::sensors::{ChannelKind, NoiseModel, PAPER_CHANNELS, noisy_name};
 use crate::sim::output::Recording;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Columns a float32 data set still stores as float64: time and track position (f32 would
 /// lose the sample time after about a minute and the position to centimetres).
@@ -131,13 +131,46 @@ pub fn write_run(path: &Path, rec: &Recording, format: Format, float32: bool) ->
     }
 }
 
-/// The track a run file was simulated on, as its data set's manifest or its own
-/// `<run>.meta.json` (written by `simulate`) records it; `None` where neither does.
-pub fn recorded_track(run_file: &Path) -> Option<super::FileRef> {
-    if let Some((_, run)) = super::run_entry(run_file) {
-        return Some(run.track);
+/// What a run file's record says of how it was made: its own `<run>.meta.json` (written by
+/// `simulate`) or else its entry in its data set's `manifest.json`. `view` and `assess` read it.
+#[derive(Debug, Clone, Default)]
+pub struct RecordedRun {
+    /// The vehicle file.
+    pub vehicle: Option<PathBuf>,
+    /// The track file, with its hash and name where recorded.
+    pub track: Option<super::FileRef>,
+    /// The irregularity seed.
+    pub seed: Option<u64>,
+    /// The speed, km/h.
+    pub speed_kmh: Option<f64>,
+}
+
+/// The record of `run_file` ([`RecordedRun`]); empty where neither record exists.
+pub fn recorded_run(run_file: &Path) -> RecordedRun {
+    let meta = std::fs::read_to_string(run_file.with_extension("meta.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok());
+    if let Some(m) = meta {
+        let file = |v: &serde_json::Value| v["file"].as_str().map(PathBuf::from);
+        let text = |v: &serde_json::Value| v.as_str().unwrap_or_default().to_string();
+        return RecordedRun {
+            vehicle: file(&m["vehicle"]),
+            track: file(&m["track"]).map(|f| super::FileRef {
+                file: f,
+                hash_fnv1a: text(&m["track"]["hash_fnv1a"]),
+                name: text(&m["track"]["name"]),
+            }),
+            seed: m["seed"].as_u64(),
+            speed_kmh: m["speed_kmh"].as_f64(),
+        };
     }
-    let meta = run_file.with_extension("meta.json");
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(meta).ok()?).ok()?;
-    serde_json::from_value(v.get("track")?.clone()).ok()
+    match super::run_entry(run_file) {
+        Some((m, r)) => RecordedRun {
+            vehicle: Some(m.vehicle.file),
+            track: Some(r.track),
+            seed: Some(r.realisation_seed.unwrap_or(r.seed)),
+            speed_kmh: Some(r.speed_kmh),
+        },
+        None => RecordedRun::default(),
+    }
 }
